@@ -1,0 +1,30 @@
+# Compiler settings as INTERFACE targets, linked PRIVATE by every project target.
+
+# Warnings. -Werror only when CULLIDE_WERROR is on (CI turns it on).
+add_library(cullide_warnings INTERFACE)
+add_library(cullide::warnings ALIAS cullide_warnings)
+target_compile_options(cullide_warnings INTERFACE
+  -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor -Wcast-align -Wunused -Woverloaded-virtual
+  -Wnull-dereference -Wdouble-promotion -Wformat=2 -Wimplicit-fallthrough
+  $<$<BOOL:${CULLIDE_WERROR}>:-Werror>)
+
+# Floating point: determinism is a contract (docs/determinism.md). No contraction into FMA, no
+# fast-math, no excess precision (x87 is never used on x86-64, but say it anyway).
+add_library(cullide_fp INTERFACE)
+add_library(cullide::fp ALIAS cullide_fp)
+target_compile_options(cullide_fp INTERFACE -ffp-contract=off -fno-fast-math)
+if(CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+  # clang spells it differently and has no -fexcess-precision for C++.
+  target_compile_options(cullide_fp INTERFACE -fno-unsafe-math-optimizations)
+endif()
+
+# Sanitizers, applied to everything built in this tree when CULLIDE_SANITIZE is set.
+if(CULLIDE_SANITIZE)
+  add_compile_options(-fsanitize=${CULLIDE_SANITIZE} -fno-omit-frame-pointer -fno-sanitize-recover=all)
+  add_link_options(-fsanitize=${CULLIDE_SANITIZE})
+endif()
+
+# One call for every project target.
+function(cullide_target_defaults target)
+  target_link_libraries(${target} PRIVATE cullide::warnings cullide::fp)
+endfunction()

@@ -1,0 +1,72 @@
+#include "cullide/mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace cullide {
+
+Aabb triangle_bounds(const Mesh& mesh, std::size_t triangle) {
+    const Tri& t = mesh.triangles[triangle];
+    const Vec3& a = mesh.positions[t[0]];
+    const Vec3& b = mesh.positions[t[1]];
+    const Vec3& c = mesh.positions[t[2]];
+    Aabb box;
+    for (int k = 0; k < 3; ++k) {
+        box.lo[k] = std::min({a[k], b[k], c[k]});
+        box.hi[k] = std::max({a[k], b[k], c[k]});
+    }
+    return box;
+}
+
+Aabb mesh_bounds(const Mesh& mesh) {
+    Aabb box;
+    bool first = true;
+    for (const Tri& t : mesh.triangles) {
+        for (std::uint32_t v : t) {
+            const Vec3& p = mesh.positions[v];
+            for (int k = 0; k < 3; ++k) {
+                box.lo[k] = first ? p[k] : std::min(box.lo[k], p[k]);
+                box.hi[k] = first ? p[k] : std::max(box.hi[k], p[k]);
+            }
+            first = false;
+        }
+    }
+    return box;
+}
+
+bool overlaps(const Aabb& a, const Aabb& b) {
+    return a.lo.x <= b.hi.x && b.lo.x <= a.hi.x && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y &&
+           a.lo.z <= b.hi.z && b.lo.z <= a.hi.z;
+}
+
+Status validate_mesh(const Mesh& mesh) {
+    const std::string who = "mesh '" + mesh.name + "'";
+    if (mesh.triangles.empty()) return Error{who + ": has no triangles"};
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+        const Vec3& p = mesh.positions[i];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+            return Error{who + ": vertex " + std::to_string(i) + " has a non-finite coordinate"};
+        }
+    }
+    for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t v = mesh.triangles[i][k];
+            if (v >= mesh.positions.size()) {
+                return Error{who + ": triangle " + std::to_string(i) + " vertex index " + std::to_string(v) +
+                             " is beyond the vertex list (size " + std::to_string(mesh.positions.size()) + ")"};
+            }
+        }
+    }
+    return {};
+}
+
+Status validate_scene(std::span<const Mesh> objects) {
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+        Status s = validate_mesh(objects[i]);
+        if (!s) return Error{"object " + std::to_string(i) + ": " + s.error().message};
+    }
+    return {};
+}
+
+}  // namespace cullide
