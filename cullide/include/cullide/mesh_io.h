@@ -22,6 +22,9 @@ enum class MeshFormat { Obj, Ply, Stl };
 // Mesh::name is the file's stem, or "stem/group" for OBJ groups.
 [[nodiscard]] Result<std::vector<Mesh>> read_mesh_file(const std::string& path);
 
+// The format named by a path's extension (.obj, .ply, .stl, any case), or an error naming the path.
+[[nodiscard]] Result<MeshFormat> mesh_format_from_path(const std::string& path);
+
 // Parses bytes already in memory. `source` names them in messages (a path, or "<fuzz>").
 [[nodiscard]] Result<std::vector<Mesh>> parse_mesh(std::string_view bytes, MeshFormat format,
                                                    const std::string& source);
