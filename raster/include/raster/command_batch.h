@@ -1,0 +1,67 @@
+// raster/command_batch.h: draws and occlusion queries recorded in GL order, executed in one pass.
+// Conventions: raster/raster.h.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "raster/depth_target.h"
+#include "raster/result.h"
+#include "raster/types.h"
+
+namespace raster {
+
+// One recorded command. Draw: mesh + state. BeginQuery/EndQuery: the query with index `query`.
+struct Command {
+    enum class Kind : std::uint8_t { Draw, BeginQuery, EndQuery };
+    Kind kind = Kind::Draw;
+    std::uint32_t query = 0;
+    MeshView mesh;
+    DrawState state;
+};
+
+// A command list for a target of one size. Recording never fails; execute() validates everything
+// first and reports the first problem (naming the command, the element and the limit).
+class CommandBatch {
+   public:
+    CommandBatch(int target_width, int target_height) : width_(target_width), height_(target_height) {}
+
+    void draw(MeshView mesh, const DrawState& state);
+    // glBeginQuery; returns the query's index into the results of execute().
+    std::uint32_t begin_query(QueryKind kind);
+    void end_query();                         // glEndQuery of the active query
+
+    [[nodiscard]] int target_width() const { return width_; }
+    [[nodiscard]] int target_height() const { return height_; }
+    [[nodiscard]] const std::vector<Command>& commands() const { return commands_; }
+    [[nodiscard]] const std::vector<QueryKind>& query_kinds() const { return query_kinds_; }
+    void clear();
+
+   private:
+    int width_;
+    int height_;
+    std::vector<Command> commands_;
+    std::vector<QueryKind> query_kinds_;
+};
+
+// How execute() runs. threads = 0: one (the serial executor is used when built without oneTBB).
+struct ExecuteOptions {
+    int threads = 1;
+    bool allow_simd = true;  // false: always the portable kernel (tests compare the two)
+};
+
+// Query results, indexed like begin_query() returned: samples passed for SamplesPassed queries,
+// 0 or 1 for AnySamplesPassed.
+using QueryResults = std::vector<std::uint64_t>;
+
+// Tiled execution: the target is split into 64 x 64 tiles, each owned by one task; per-tile
+// counters are summed in tile order. Bit-identical to execute_reference for any thread count.
+[[nodiscard]] Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch,
+                                           const ExecuteOptions& options = {});
+
+// The scalar reference: commands one by one, each triangle over its whole bounding box, on one
+// thread (options.threads is ignored; allow_simd is honoured).
+[[nodiscard]] Result<QueryResults> execute_reference(DepthTarget& target, const CommandBatch& batch,
+                                                     const ExecuteOptions& options = {});
+
+}  // namespace raster

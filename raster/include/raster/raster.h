@@ -1,0 +1,51 @@
+// raster/raster.h: cullide's depth-only software rasterizer and occlusion-query emulator.
+//
+// It reproduces, bit for bit, what OpenGL on Mesa's llvmpipe (OSMesa 22.3.6, x86-64 host with FMA)
+// writes into a depth buffer and counts in GL_SAMPLES_PASSED queries, for depth-only drawing of
+// indexed triangles given in clip space. Every rule below was pinned by an experiment against that
+// oracle (docs/conventions.md, "Rasterization (GL-exact mode)", names the experiment for each);
+// tests/raster/conformance_test.cpp re-checks them on random scenes.
+//
+// Conventions (GL names throughout; "window" = GL window coordinates, y up):
+//  - Target: DepthTarget, width x height pixels, 1 <= width, height <= kMaxTargetSize. Pixel (x, y)
+//    covers [x, x+1) x [y, y+1); row 0 is the bottom row (glReadPixels order). Formats D16, D24
+//    (unsigned normalized, stored in the low 16/24 bits of a uint32) and D32F (float bits).
+//  - Input: clip-space float4 vertices (x, y, z, w) and uint32 indices, three per triangle, in the
+//    GL_TRIANGLES order. Clip volume -w <= x, y, z <= w; GL default depth range [0, 1]; no depth
+//    clamp. Triangles crossing the volume are clipped against all six planes in clip space
+//    (llvmpipe runs without a guard band), in the plane order +x, -x, +y, -y, near, far.
+//  - Viewport (glViewport): x_w = (x/w) * (width/2) + (x0 + width/2), computed as llvmpipe does:
+//    1/w first, then one fused multiply-add; z_w = (z/w) * 0.5 + 0.5 the same way. Pixels outside
+//    the target are never touched; pixels outside a smaller viewport only by rounding, as in GL.
+//  - Sampling: one sample at each pixel centre (x + 0.5, y + 0.5). Vertices are snapped to 1/256
+//    pixel (16.8 fixed point, round half to even, after subtracting the 0.5 centre offset).
+//  - Fill rule: a centre on an edge belongs to the triangle for left edges and bottom horizontal
+//    edges only (llvmpipe's GL rule); shared edges are watertight. Zero-area triangles (in 16.8
+//    fixed point) produce nothing.
+//  - Facing: counter-clockwise in window coordinates (positive fixed-point area) is front when
+//    FrontFace::CCW. Culling uses the snapped area, as llvmpipe does.
+//  - Depth: a plane through the three float window positions, evaluated at the centre as
+//    fma(dzdy, y, fma(dzdx, x, z0)) in float, clamped to [0, 1] and converted: D16 via the
+//    float magic-number path, D24 as round-half-even(z * 16777215.0f), D32F unchanged.
+//  - Depth test: DepthFunc compares the incoming value (left) with the stored one (right); the
+//    stored value is replaced only when the test passes and the write mask is on.
+//  - Queries: samples_passed counts samples that pass the depth test (mask on or off); any-samples
+//    is samples_passed > 0. Queries do not nest (one active at a time), as with one GL target.
+//  - Limits: kMaxTargetSize = 16384 per side, so 16.8 coordinates need at most 23 bits and edge
+//    products fit in 64 bits (2^23 * 2^23 * 2).
+//  - Errors: non-finite coordinates, indices out of range, index counts not a multiple of 3,
+//    zero-size or oversized targets or viewports, unbalanced queries and a batch built for another
+//    target size are rejected before anything is drawn; the target is then unchanged.
+//  - Determinism: same input, same bits, for the scalar reference and the tiled path with any
+//    thread count. Depth is computed from the plane at each pixel, never accumulated.
+//
+// Room left for a second raster mode ("exact bounds", conservative: every pixel a triangle touches,
+// with [zmin, zmax] over the pixel; writes use zmin, queries zmax), selected per draw through
+// DrawState::mode. Only RasterMode::GLExact exists today.
+#pragma once
+
+#include "raster/command_batch.h"
+#include "raster/depth_target.h"
+#include "raster/result.h"
+#include "raster/transform.h"
+#include "raster/types.h"

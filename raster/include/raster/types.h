@@ -1,0 +1,61 @@
+// raster/types.h: the GL-state enums and small value types of the raster library.
+// Conventions: raster/raster.h.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+
+namespace raster {
+
+// Per side, in pixels. Keeps 16.8 fixed-point products inside 64 bits (see raster.h).
+inline constexpr int kMaxTargetSize = 16384;
+
+enum class DepthFormat : std::uint8_t { D16, D24, D32F };
+
+// GL depth functions (glDepthFunc), compared as incoming <op> stored.
+enum class DepthFunc : std::uint8_t { Never, Less, Equal, LEqual, Greater, NotEqual, GEqual, Always };
+
+enum class CullFace : std::uint8_t { None, Front, Back };   // glCullFace (None = GL_CULL_FACE off)
+enum class FrontFace : std::uint8_t { CCW, CW };           // glFrontFace
+
+// How coverage and depth are decided. GLExact: pixel-centre sampling exactly as llvmpipe.
+// (Reserved: a conservative "exact bounds" mode with per-pixel depth ranges.)
+enum class RasterMode : std::uint8_t { GLExact };
+
+enum class QueryKind : std::uint8_t { SamplesPassed, AnySamplesPassed };
+
+// glViewport(x, y, width, height) in pixels.
+struct Viewport {
+    int x = 0;
+    int y = 0;
+    int width = 0;
+    int height = 0;
+};
+
+// A clip-space vertex (x, y, z, w), as gl_Position.
+struct Float4 {
+    float x = 0.0f;
+    float y = 0.0f;
+    float z = 0.0f;
+    float w = 1.0f;
+};
+
+// Non-owning view of an indexed triangle mesh in clip space; three indices per triangle. The
+// spans must stay valid until the batch that holds the view has been executed.
+struct MeshView {
+    std::span<const Float4> vertices;
+    std::span<const std::uint32_t> indices;
+};
+
+// The GL state one draw runs under. GL_DEPTH_TEST is always on (use DepthFunc::Always for "no test").
+struct DrawState {
+    DepthFunc depth_func = DepthFunc::Less;
+    bool depth_write = true;                 // glDepthMask
+    CullFace cull_face = CullFace::None;
+    FrontFace front_face = FrontFace::CCW;
+    std::optional<Viewport> viewport;        // nullopt: the whole target
+    RasterMode mode = RasterMode::GLExact;
+};
+
+}  // namespace raster

@@ -1,0 +1,181 @@
+// execute.cpp: the scalar reference executor and the tiled (optionally multithreaded) executor.
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "pipeline.h"
+#include "raster/command_batch.h"
+#include "validate.h"
+
+#if defined(CULLIDE_HAVE_TBB)
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+#endif
+
+namespace raster {
+namespace {
+
+constexpr std::uint32_t kNoQuery = std::numeric_limits<std::uint32_t>::max();
+constexpr int kTileSize = 64;  // llvmpipe's tile size; one task owns one tile
+
+detail::FrontEndParams params_for(const DepthTarget& target, const DrawState& s) {
+    detail::FrontEndParams p{};
+    p.target_width = target.width();
+    p.target_height = target.height();
+    p.viewport = s.viewport ? *s.viewport : Viewport{0, 0, target.width(), target.height()};
+    p.cull_face = s.cull_face;
+    p.front_face = s.front_face;
+    return p;
+}
+
+void finish_results(const CommandBatch& batch, QueryResults& r) {
+    const auto& kinds = batch.query_kinds();
+    for (std::size_t q = 0; q < r.size(); ++q)
+        if (kinds[q] == QueryKind::AnySamplesPassed) r[q] = r[q] > 0 ? 1 : 0;
+}
+
+template <class F>
+void run_parallel(int threads, std::size_t n, const F& body) {
+#if defined(CULLIDE_HAVE_TBB)
+    if (threads > 1 && n > 1) {
+        oneapi::tbb::task_arena arena(threads);
+        arena.execute([&] {
+            oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, n, 1),
+                                      [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
+                                          for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
+                                      });
+        });
+        return;
+    }
+#else
+    (void)threads;
+#endif
+    for (std::size_t i = 0; i < n; ++i) body(i);
+}
+
+}  // namespace
+
+Result<QueryResults> execute_reference(DepthTarget& target, const CommandBatch& batch, const ExecuteOptions& options) {
+    if (Status s = detail::validate(target, batch); !s) return s.error();
+    QueryResults results(batch.query_kinds().size(), 0);
+    std::uint32_t active = kNoQuery;
+    std::vector<detail::SetupTri> tris;
+    std::uint32_t* depth = target.mutable_values().data();
+    const auto& cmds = batch.commands();
+    for (std::size_t i = 0; i < cmds.size(); ++i) {
+        const Command& c = cmds[i];
+        if (c.kind == Command::Kind::BeginQuery) {
+            active = c.query;
+            continue;
+        }
+        if (c.kind == Command::Kind::EndQuery) {
+            active = kNoQuery;
+            continue;
+        }
+        const detail::FrontEndParams p = params_for(target, c.state);
+        const auto& idx = c.mesh.indices;
+        const auto& vtx = c.mesh.vertices;
+        for (std::size_t k = 0; k + 2 < idx.size(); k += 3) {
+            tris.clear();
+            detail::setup_triangle(p, vtx[idx[k]], vtx[idx[k + 1]], vtx[idx[k + 2]], static_cast<std::uint32_t>(i),
+                                   tris);
+            for (const auto& t : tris) {
+                const std::uint64_t passed = detail::raster_rect(t, target.format(), c.state.depth_func,
+                                                                 c.state.depth_write, depth, target.width(), t.x0,
+                                                                 t.y0, t.x1, t.y1, options.allow_simd);
+                if (active != kNoQuery) results[active] += passed;
+            }
+        }
+    }
+    finish_results(batch, results);
+    return results;
+}
+
+Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, const ExecuteOptions& options) {
+    if (Status s = detail::validate(target, batch); !s) return s.error();
+    const int threads = std::max(1, options.threads);
+    const auto& cmds = batch.commands();
+
+    // Front end, per draw in parallel; each draw's triangles land in its own list so the order is
+    // the command order whatever the schedule.
+    std::vector<std::uint32_t> draw_cmds;
+    std::vector<std::uint32_t> draw_query;  // active query of each draw command (by command index)
+    std::vector<std::uint32_t> cmd_query(cmds.size(), kNoQuery);
+    {
+        std::uint32_t active = kNoQuery;
+        for (std::size_t i = 0; i < cmds.size(); ++i) {
+            if (cmds[i].kind == Command::Kind::BeginQuery) active = cmds[i].query;
+            else if (cmds[i].kind == Command::Kind::EndQuery) active = kNoQuery;
+            else {
+                draw_cmds.push_back(static_cast<std::uint32_t>(i));
+                cmd_query[i] = active;
+            }
+        }
+    }
+    std::vector<std::vector<detail::SetupTri>> per_draw(draw_cmds.size());
+    run_parallel(threads, draw_cmds.size(), [&](std::size_t d) {
+        const Command& c = cmds[draw_cmds[d]];
+        const detail::FrontEndParams p = params_for(target, c.state);
+        const auto& idx = c.mesh.indices;
+        const auto& vtx = c.mesh.vertices;
+        auto& out = per_draw[d];
+        for (std::size_t k = 0; k + 2 < idx.size(); k += 3)
+            detail::setup_triangle(p, vtx[idx[k]], vtx[idx[k + 1]], vtx[idx[k + 2]], draw_cmds[d], out);
+    });
+
+    // Binning: each tile lists the triangles overlapping it, in command order.
+    const int tiles_x = (target.width() + kTileSize - 1) / kTileSize;
+    const int tiles_y = (target.height() + kTileSize - 1) / kTileSize;
+    const std::size_t tile_count = static_cast<std::size_t>(tiles_x) * static_cast<std::size_t>(tiles_y);
+    struct Ref {
+        std::uint32_t draw;
+        std::uint32_t tri;
+    };
+    std::vector<std::vector<Ref>> bins(tile_count);
+    for (std::size_t d = 0; d < per_draw.size(); ++d) {
+        for (std::size_t t = 0; t < per_draw[d].size(); ++t) {
+            const auto& tri = per_draw[d][t];
+            for (int ty = tri.y0 / kTileSize; ty <= tri.y1 / kTileSize; ++ty)
+                for (int tx = tri.x0 / kTileSize; tx <= tri.x1 / kTileSize; ++tx)
+                    bins[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x) + static_cast<std::size_t>(tx)]
+                        .push_back({static_cast<std::uint32_t>(d), static_cast<std::uint32_t>(t)});
+        }
+    }
+
+    // Back end: one task per tile; counters kept per tile as (query, count) runs.
+    std::vector<std::vector<std::pair<std::uint32_t, std::uint64_t>>> tile_counts(tile_count);
+    std::uint32_t* depth = target.mutable_values().data();
+    const int width = target.width();
+    const int height = target.height();
+    const DepthFormat format = target.format();
+    run_parallel(threads, tile_count, [&](std::size_t tile) {
+        const int tx = static_cast<int>(tile % static_cast<std::size_t>(tiles_x));
+        const int ty = static_cast<int>(tile / static_cast<std::size_t>(tiles_x));
+        const int x0 = tx * kTileSize, y0 = ty * kTileSize;
+        const int x1 = std::min(x0 + kTileSize, width) - 1, y1 = std::min(y0 + kTileSize, height) - 1;
+        auto& counts = tile_counts[tile];
+        for (const Ref& r : bins[tile]) {
+            const auto& tri = per_draw[r.draw][r.tri];
+            const Command& c = cmds[tri.draw];
+            const std::uint64_t passed =
+                detail::raster_rect(tri, format, c.state.depth_func, c.state.depth_write, depth, width,
+                                    std::max(x0, tri.x0), std::max(y0, tri.y0), std::min(x1, tri.x1),
+                                    std::min(y1, tri.y1), options.allow_simd);
+            const std::uint32_t q = cmd_query[tri.draw];
+            if (q == kNoQuery || passed == 0) continue;
+            if (!counts.empty() && counts.back().first == q) counts.back().second += passed;
+            else counts.emplace_back(q, passed);
+        }
+    });
+
+    QueryResults results(batch.query_kinds().size(), 0);
+    for (const auto& counts : tile_counts)
+        for (const auto& [q, n] : counts) results[q] += n;
+    finish_results(batch, results);
+    return results;
+}
+
+}  // namespace raster

@@ -1,0 +1,256 @@
+// pipeline.cpp: llvmpipe's triangle front end and the per-rectangle back end. See pipeline.h.
+#include "pipeline.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+
+namespace raster::detail {
+namespace {
+
+// A vertex as the draw module carries it: the clip-space position (used for clipping) and the
+// window position computed from it (used by setup).
+struct ClipVertex {
+    float clip[4];
+    float win[3];
+};
+
+constexpr int kFixedOrder = 8;  // 16.8: 1/256 pixel
+constexpr float kFixedOne = 256.0f;
+
+// Plane i of the clip volume as draw_context.c lists them: dot(clip, plane) >= 0 is inside.
+constexpr float kPlanes[6][4] = {
+    {-1.0f, 0.0f, 0.0f, 1.0f},  // x <= w
+    {1.0f, 0.0f, 0.0f, 1.0f},   // x >= -w
+    {0.0f, -1.0f, 0.0f, 1.0f},  // y <= w
+    {0.0f, 1.0f, 0.0f, 1.0f},   // y >= -w
+    {0.0f, 0.0f, 1.0f, 1.0f},   // z >= -w (near, GL depth mode)
+    {0.0f, 0.0f, -1.0f, 1.0f},  // z <= w (far)
+};
+
+// Left to right, as the C compiler evaluates it (no contraction on baseline x86-64).
+float dot4(const float* a, const float* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]; }
+
+// The clip mask bits, as the vertex shader computes them (same plane order).
+unsigned clip_mask(const float* p) {
+    unsigned m = 0;
+    if (p[0] > p[3]) m |= 1u;
+    if (0.0f > p[0] + p[3]) m |= 2u;
+    if (p[1] > p[3]) m |= 4u;
+    if (0.0f > p[1] + p[3]) m |= 8u;
+    if (0.0f > p[2] + p[3]) m |= 16u;
+    if (p[2] > p[3]) m |= 32u;
+    return m;
+}
+
+struct ViewportXform {
+    float scale[3];
+    float translate[3];
+};
+
+ViewportXform make_xform(const Viewport& vp) {
+    ViewportXform x{};
+    const float hw = static_cast<float>(vp.width) * 0.5f;
+    const float hh = static_cast<float>(vp.height) * 0.5f;
+    x.scale[0] = hw;
+    x.scale[1] = hh;
+    x.scale[2] = 0.5f;
+    x.translate[0] = hw + static_cast<float>(vp.x);
+    x.translate[1] = hh + static_cast<float>(vp.y);
+    x.translate[2] = 0.5f;
+    return x;
+}
+
+// Window position of an unclipped vertex (the vertex shader's viewport stage: one division,
+// then a multiply-add that LLVM fuses on an FMA host).
+void shader_viewport(const ViewportXform& xf, ClipVertex& v) {
+    const float oow = 1.0f / v.clip[3];
+    for (int i = 0; i < 3; ++i) {
+        const float ndc = v.clip[i] * oow;
+        v.win[i] = kFusedViewport ? std::fma(ndc, xf.scale[i], xf.translate[i]) : ndc * xf.scale[i] + xf.translate[i];
+    }
+}
+
+// Window position of a vertex made by the clipper (C code: never fused).
+void clipper_viewport(const ViewportXform& xf, ClipVertex& v) {
+    const float oow = 1.0f / v.clip[3];
+    for (int i = 0; i < 3; ++i) v.win[i] = v.clip[i] * oow * xf.scale[i] + xf.translate[i];
+}
+
+// dst = out + t * (in - out), per clip coordinate.
+ClipVertex interpolate(const ViewportXform& xf, float t, const ClipVertex& out, const ClipVertex& in) {
+    ClipVertex d{};
+    for (int i = 0; i < 4; ++i) d.clip[i] = out.clip[i] + t * (in.clip[i] - out.clip[i]);
+    clipper_viewport(xf, d);
+    return d;
+}
+
+// llvmpipe's setup of one (post-clip) triangle in window coordinates.
+void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const ClipVertex* v1,
+                           const ClipVertex* v2, std::uint32_t draw, std::vector<SetupTri>& out) {
+    // Snap to 16.8 after moving the pixel centre to the integer lattice (round half to even, as
+    // cvtps2dq does in the default rounding mode).
+    auto snap = [](float w) { return static_cast<int64_t>(std::lrint((w - 0.5f) * kFixedOne)); };
+    int64_t x[3] = {snap(v0->win[0]), snap(v1->win[0]), snap(v2->win[0])};
+    int64_t y[3] = {snap(v0->win[1]), snap(v1->win[1]), snap(v2->win[1])};
+    // llvmpipe's area: positive is clockwise in GL window coordinates (y up).
+    const int64_t area = (x[0] - x[1]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[0] - y[1]);
+    if (area == 0) return;
+
+    const bool lp_positive = area > 0;
+    const bool gl_ccw = kLpPositiveIsCcw ? lp_positive : !lp_positive;
+    const bool front = gl_ccw == (p.front_face == FrontFace::CCW);
+    if (p.cull_face == CullFace::Back && !front) return;
+    if (p.cull_face == CullFace::Front && front) return;
+
+    // Setup works on llvmpipe's positive orientation; a negative triangle swaps vertices 0 and 1
+    // (provoking vertex last), which also decides the vertex order of the depth plane below.
+    const ClipVertex* v[3] = {v0, v1, v2};
+    if (!lp_positive) {
+        std::swap(v[0], v[1]);
+        std::swap(x[0], x[1]);
+        std::swap(y[0], y[1]);
+    }
+
+    SetupTri t{};
+    // Bounding box (inclusive), llvmpipe's rounding for its fill convention.
+    const int adj = kBottomEdgeRule ? 1 : 0;
+    const int64_t minx = std::min({x[0], x[1], x[2]}), maxx = std::max({x[0], x[1], x[2]});
+    const int64_t miny = std::min({y[0], y[1], y[2]}), maxy = std::max({y[0], y[1], y[2]});
+    int64_t bx0 = minx >> kFixedOrder;
+    int64_t bx1 = (maxx - 1) >> kFixedOrder;
+    int64_t by0 = (miny + adj) >> kFixedOrder;
+    int64_t by1 = (maxy - 1 + adj) >> kFixedOrder;
+    bx0 = std::max<int64_t>(bx0, 0);
+    by0 = std::max<int64_t>(by0, 0);
+    bx1 = std::min<int64_t>(bx1, p.target_width - 1);
+    by1 = std::min<int64_t>(by1, p.target_height - 1);
+    if (bx0 > bx1 || by0 > by1) return;
+    t.x0 = static_cast<int>(bx0);
+    t.y0 = static_cast<int>(by0);
+    t.x1 = static_cast<int>(bx1);
+    t.y1 = static_cast<int>(by1);
+
+    for (int i = 0; i < 3; ++i) {
+        const int j = (i + 1) % 3;
+        const int64_t dcdx = y[i] - y[j];
+        const int64_t dcdy = x[i] - x[j];
+        int64_t c = dcdx * x[i] - dcdy * y[i];
+        // Fill-rule bias: a centre exactly on the edge counts for left edges (dcdx < 0) and, for
+        // horizontal edges, on the side the convention picks.
+        const bool horizontal_in = kBottomEdgeRule ? dcdy < 0 : dcdy >= 0;
+        if (dcdx < 0 || (dcdx == 0 && horizontal_in)) c += 1;
+        t.c[i] = c;
+        t.dcdx[i] = dcdx;
+        t.dcdy[i] = dcdy;
+    }
+
+    // Depth plane from the float window positions, in llvmpipe's operation order.
+    const float x0c = v[0]->win[0] - 0.5f;
+    const float y0c = v[0]->win[1] - 0.5f;
+    const float dx01 = v[0]->win[0] - v[1]->win[0];
+    const float dy01 = v[0]->win[1] - v[1]->win[1];
+    const float dx20 = v[2]->win[0] - v[0]->win[0];
+    const float dy20 = v[2]->win[1] - v[0]->win[1];
+    const float e = dx01 * dy20;
+    const float f = dy01 * dx20;
+    const float ooa = 1.0f / (e - f);
+    const float dy20_ooa = dy20 * ooa;
+    const float dy01_ooa = dy01 * ooa;
+    const float dx20_ooa = dx20 * ooa;
+    const float dx01_ooa = dx01 * ooa;
+    const float da01 = v[0]->win[2] - v[1]->win[2];
+    const float da20 = v[2]->win[2] - v[0]->win[2];
+    const float dadx = da01 * dy20_ooa - da20 * dy01_ooa;
+    const float dady = da20 * dx01_ooa - da01 * dx20_ooa;
+    const float a0 = v[0]->win[2] - (dadx * x0c + dady * y0c);
+    t.z0 = a0;
+    t.dzdx = dadx;
+    t.dzdy = dady;
+    t.draw = draw;
+    out.push_back(t);
+}
+
+}  // namespace
+
+void setup_triangle(const FrontEndParams& params, const Float4& a, const Float4& b, const Float4& c,
+                    std::uint32_t draw, std::vector<SetupTri>& out) {
+    const ViewportXform xf = make_xform(params.viewport);
+    ClipVertex in[3] = {{{a.x, a.y, a.z, a.w}, {}}, {{b.x, b.y, b.z, b.w}, {}}, {{c.x, c.y, c.z, c.w}, {}}};
+    unsigned m[3];
+    for (int i = 0; i < 3; ++i) m[i] = clip_mask(in[i].clip);
+    if ((m[0] & m[1] & m[2]) != 0) return;  // wholly outside one plane
+    for (auto& v : in) shader_viewport(xf, v);
+    if ((m[0] | m[1] | m[2]) == 0) {
+        setup_window_triangle(params, &in[0], &in[1], &in[2], draw, out);
+        return;
+    }
+
+    // Sutherland-Hodgman against each plane in the mask, lowest bit first, keeping the polygon's
+    // first vertex first (draw_pipe_clip.c's do_clip_tri).
+    constexpr int kMaxVerts = 3 + 6 + 1;
+    ClipVertex pool[2 * kMaxVerts];
+    int pool_used = 0;
+    const ClipVertex* list_a[kMaxVerts + 1] = {&in[0], &in[1], &in[2]};
+    const ClipVertex* list_b[kMaxVerts + 1] = {};
+    const ClipVertex** inlist = list_a;
+    const ClipVertex** outlist = list_b;
+    int n = 3;
+    unsigned mask = m[0] | m[1] | m[2];
+    while (mask != 0 && n >= 3) {
+        const int plane = std::countr_zero(mask);
+        mask &= ~(1u << plane);
+        const ClipVertex* prev = inlist[0];
+        float dp_prev = dot4(prev->clip, kPlanes[plane]);
+        if (!std::isfinite(dp_prev)) return;
+        inlist[n] = inlist[0];
+        int count = 0;
+        for (int i = 1; i <= n; ++i) {
+            const ClipVertex* cur = inlist[i];
+            const float dp = dot4(cur->clip, kPlanes[plane]);
+            if (!std::isfinite(dp)) return;
+            bool different;
+            if (dp_prev >= 0.0f) {
+                outlist[count++] = prev;
+                different = dp < 0.0f;
+            } else {
+                different = !(dp < 0.0f);
+            }
+            if (different) {
+                if (pool_used >= 2 * kMaxVerts || count >= kMaxVerts) return;
+                ClipVertex& nv = pool[pool_used++];
+                const float denom = dp - dp_prev;
+                if (dp < 0.0f) {  // leaving
+                    if (!kSymmetricClipT || -dp < dp_prev) {
+                        nv = interpolate(xf, dp / denom, *cur, *prev);
+                    } else {
+                        nv = interpolate(xf, -dp_prev / denom, *prev, *cur);
+                    }
+                } else {  // entering
+                    if (!kSymmetricClipT || -dp_prev < dp) {
+                        nv = interpolate(xf, -dp_prev / denom, *prev, *cur);
+                    } else {
+                        nv = interpolate(xf, dp / denom, *cur, *prev);
+                    }
+                }
+                outlist[count++] = &nv;
+            }
+            prev = cur;
+            dp_prev = dp;
+        }
+        std::swap(inlist, outlist);
+        n = count;
+    }
+    // The polygon as a fan, provoking vertex (the first) last in each triangle.
+    for (int i = 2; i < n; ++i) setup_window_triangle(params, inlist[i - 1], inlist[i], inlist[0], draw, out);
+}
+
+std::uint64_t raster_rect(const SetupTri& tri, DepthFormat format, DepthFunc func, bool write, std::uint32_t* depth,
+                          int stride, int rx0, int ry0, int rx1, int ry1, bool allow_simd) {
+    if (allow_simd && kernel_avx2_available())
+        return raster_rect_avx2(tri, format, func, write, depth, stride, rx0, ry0, rx1, ry1);
+    return raster_rect_portable(tri, format, func, write, depth, stride, rx0, ry0, rx1, ry1);
+}
+
+}  // namespace raster::detail

@@ -1,0 +1,64 @@
+// pipeline.h (private): llvmpipe's triangle pipeline, split in a front end (clip, viewport,
+// snap, edge and depth-plane setup: one SetupTri per rasterized triangle) and a back end (coverage
+// and depth test of one SetupTri over a pixel rectangle). Both the scalar reference and the tiled
+// executor use these two functions, so they agree bit for bit by construction; they differ only in
+// traversal (whole bounding box vs. tile by tile).
+//
+// Sources of the rules (read for facts, code ours): Mesa src/gallium/auxiliary/draw/draw_pipe_clip.c
+// (Sutherland-Hodgman clipping in clip space), draw_llvm.c (clip mask, viewport), llvmpipe
+// lp_setup_tri.c (16.8 snapping, edge functions, fill-rule bias, bounding box), lp_state_setup.c
+// (depth plane), lp_bld_interp.c (per-pixel evaluation), lp_bld_conv.c (unorm conversion).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "raster/types.h"
+
+namespace raster::detail {
+
+// Experiment switches (each pinned against OSMesa; docs/conventions.md). Not user options.
+inline constexpr bool kFusedViewport = true;   // draw_llvm: fmuladd(x * (1/w), scale, trans)
+inline constexpr bool kFusedInterp = true;     // lp_bld_interp: fmuladd(dady, y, fmuladd(dadx, x, a0))
+inline constexpr bool kSymmetricClipT = true;  // draw_pipe_clip: t measured from the nearer vertex
+inline constexpr bool kBottomEdgeRule = false;  // llvmpipe bottom_edge_rule for a GL FBO
+inline constexpr bool kLpPositiveIsCcw = false;  // llvmpipe's positive area is GL counter-clockwise?
+
+// One triangle ready for the back end. Edge i at pixel (px, py) (centre at 16.8 (px*256, py*256)
+// after the half-pixel offset): e_i = c[i] - dcdx[i] * 256 * px + dcdy[i] * 256 * py; the pixel is
+// covered when all three are > 0 (the fill-rule bias is folded into c).
+struct SetupTri {
+    std::int64_t c[3];
+    std::int64_t dcdx[3];
+    std::int64_t dcdy[3];
+    int x0, y0, x1, y1;  // inclusive pixel bounding box, already inside the target
+    float z0, dzdx, dzdy;  // depth plane: z(px, py) = fma(dzdy, py, fma(dzdx, px, z0))
+    std::uint32_t draw;  // index of the draw command in the batch
+};
+
+struct FrontEndParams {
+    int target_width;
+    int target_height;
+    Viewport viewport;
+    CullFace cull_face;
+    FrontFace front_face;
+};
+
+// Runs clipping and setup for one input triangle (clip-space vertices a, b, c), appending 0..n
+// SetupTri (a clipped triangle becomes a fan). Inputs were validated (finite).
+void setup_triangle(const FrontEndParams& params, const Float4& a, const Float4& b, const Float4& c,
+                    std::uint32_t draw, std::vector<SetupTri>& out);
+
+// Rasterizes `tri` over the rectangle [rx0, rx1] x [ry0, ry1] (inclusive, inside the target and the
+// triangle's box) into `depth` (row-major, `stride` values per row). Returns the samples that passed.
+// allow_simd picks the AVX2+FMA build of the kernel when the CPU has it (bit-identical results).
+std::uint64_t raster_rect(const SetupTri& tri, DepthFormat format, DepthFunc func, bool write,
+                          std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1, bool allow_simd);
+std::uint64_t raster_rect_portable(const SetupTri& tri, DepthFormat format, DepthFunc func, bool write,
+                                   std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1);
+std::uint64_t raster_rect_avx2(const SetupTri& tri, DepthFormat format, DepthFunc func, bool write,
+                               std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1);
+bool kernel_avx2_available();
+
+
+}  // namespace raster::detail
