@@ -35,11 +35,6 @@ Aabb mesh_bounds(const Mesh& mesh) {
     return box;
 }
 
-bool overlaps(const Aabb& a, const Aabb& b) {
-    return a.lo.x <= b.hi.x && b.lo.x <= a.hi.x && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y &&
-           a.lo.z <= b.hi.z && b.lo.z <= a.hi.z;
-}
-
 Status validate_mesh(const Mesh& mesh) {
     const std::string who = "mesh '" + mesh.name + "'";
     if (mesh.triangles.empty()) return Error{who + ": has no triangles"};

@@ -1,0 +1,282 @@
+#include "cli.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cullide/mesh_io.h"
+#include "cullide/pipeline.h"
+#include "cullide/scenes.h"
+
+namespace cullide::cli {
+namespace {
+
+constexpr const char* kUsage =
+    "usage: cullide <command> [options]\n"
+    "\n"
+    "commands:\n"
+    "  run [SCENE...]   detect colliding triangle pairs, frame by frame\n"
+    "  scenes           list the built-in scenes\n"
+    "  help             this text\n"
+    "\n"
+    "SCENE is one built-in scene name (default: cylinders) or mesh files (.obj .ply .stl); each file is\n"
+    "one object, or one object per OBJ group, in argument order.\n"
+    "\n"
+    "run options:\n"
+    "  --method M        collision method (default exact; see below)\n"
+    "  --frames N        frames to run (default 10 for built-in scenes, 1 for files; 1..1000000)\n"
+    "  --threads T       worker threads, 0 = all cores (default 0); results do not depend on it\n"
+    "  --resolution R    view resolution of visibility methods, 16..16384 (default 1024)\n"
+    "  --self            also report pairs inside one object (adjacent triangles excluded)\n"
+    "  --pairs FILE      write every colliding triangle pair as CSV:\n"
+    "                    frame,object_a,triangle_a,object_b,triangle_b\n"
+    "  --json            print the per-frame results as one JSON document instead of text\n"
+    "  --seed S          scene seed, an unsigned 64-bit integer (default 1)\n"
+    "  --scale X         scene size factor, 0 < X <= 100 (default 1)\n"
+    "  --mesh-dir DIR    where real meshes are read from (default ../shared/data/meshes)\n";
+
+struct UsageError {
+    std::string message;
+};
+
+template <class T>
+std::optional<T> parse_integer(std::string_view s) {
+    T v{};
+    auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (ec != std::errc() || ptr != s.data() + s.size() || s.empty()) return std::nullopt;
+    return v;
+}
+
+std::optional<double> parse_double(std::string_view s) {
+    double v = 0;
+    auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (ec != std::errc() || ptr != s.data() + s.size() || s.empty() || !std::isfinite(v)) return std::nullopt;
+    return v;
+}
+
+std::string json_escape(const std::string& s) {
+    std::string o;
+    for (char c : s) {
+        if (c == '"' || c == '\\') {
+            o += '\\';
+            o += c;
+        } else if (static_cast<unsigned char>(c) < 0x20) {
+            char buf[8];
+            std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
+            o += buf;
+        } else {
+            o += c;
+        }
+    }
+    return o;
+}
+
+struct RunArgs {
+    std::vector<std::string> scene;
+    RunOptions options;
+    std::optional<int> frames;
+    std::string pairs_file;
+    bool json = false;
+    SceneOptions scene_options;
+};
+
+RunArgs parse_run_args(const std::vector<std::string>& args) {
+    RunArgs r;
+    auto need_value = [&](std::size_t& i) -> const std::string& {
+        if (i + 1 >= args.size()) throw UsageError{"option " + args[i] + " needs a value"};
+        return args[++i];
+    };
+    for (std::size_t i = 1; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        if (a == "--method") {
+            const std::string& v = need_value(i);
+            Result<Method> m = parse_method(v);
+            if (!m) throw UsageError{m.error().message};
+            r.options.method = m.value();
+        } else if (a == "--frames") {
+            const std::string& v = need_value(i);
+            auto n = parse_integer<int>(v);
+            if (!n || *n < 1 || *n > 1000000) throw UsageError{"--frames must be an integer in 1..1000000 (got '" + v + "')"};
+            r.frames = *n;
+        } else if (a == "--threads") {
+            const std::string& v = need_value(i);
+            auto n = parse_integer<int>(v);
+            if (!n || *n < 0 || *n > 1024) throw UsageError{"--threads must be an integer in 0..1024 (got '" + v + "')"};
+            r.options.threads = *n;
+        } else if (a == "--resolution") {
+            const std::string& v = need_value(i);
+            auto n = parse_integer<int>(v);
+            if (!n || *n < 16 || *n > 16384) {
+                throw UsageError{"--resolution must be an integer in 16..16384 (got '" + v + "')"};
+            }
+            r.options.resolution = *n;
+        } else if (a == "--self") {
+            r.options.self = true;
+        } else if (a == "--pairs") {
+            r.pairs_file = need_value(i);
+        } else if (a == "--json") {
+            r.json = true;
+        } else if (a == "--seed") {
+            const std::string& v = need_value(i);
+            auto n = parse_integer<std::uint64_t>(v);
+            if (!n) throw UsageError{"--seed must be an unsigned 64-bit integer (got '" + v + "')"};
+            r.scene_options.seed = *n;
+        } else if (a == "--scale") {
+            const std::string& v = need_value(i);
+            auto x = parse_double(v);
+            if (!x || !(*x > 0) || *x > 100) throw UsageError{"--scale must be a number in (0, 100] (got '" + v + "')"};
+            r.scene_options.scale = *x;
+        } else if (a == "--mesh-dir") {
+            r.scene_options.mesh_dir = need_value(i);
+        } else if (a.size() > 1 && a[0] == '-') {
+            throw UsageError{"unknown option '" + a + "'"};
+        } else {
+            r.scene.push_back(a);
+        }
+    }
+    return r;
+}
+
+bool is_builtin(const std::string& name) {
+    for (const std::string& s : scene_names()) {
+        if (s == name) return true;
+    }
+    return false;
+}
+
+int run_command(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+    RunArgs r = parse_run_args(args);
+    if (r.scene.empty()) r.scene.push_back("cylinders");
+
+    // The frame source: a built-in generator, or the objects of the given files (static).
+    std::unique_ptr<SceneGenerator> generator;
+    std::vector<Mesh> file_objects;
+    std::string scene_label;
+    if (r.scene.size() == 1 && is_builtin(r.scene[0])) {
+        Result<std::unique_ptr<SceneGenerator>> g = make_scene(r.scene[0], r.scene_options);
+        if (!g) {
+            err << "cullide: error: " << g.error().message << "\n";
+            return 1;
+        }
+        generator = std::move(g).value();
+        scene_label = generator->name();
+    } else {
+        for (const std::string& path : r.scene) {
+            if (is_builtin(path)) throw UsageError{"give one built-in scene or mesh files, not both ('" + path + "')"};
+            Result<std::vector<Mesh>> meshes = read_mesh_file(path);
+            if (!meshes) {
+                err << "cullide: error: " << meshes.error().message << "\n";
+                return 1;
+            }
+            for (Mesh& m : meshes.value()) file_objects.push_back(std::move(m));
+            scene_label += (scene_label.empty() ? "" : " ") + path;
+        }
+    }
+    const int frames = r.frames.value_or(generator ? 10 : 1);
+
+    std::ofstream pairs_out;
+    if (!r.pairs_file.empty()) {
+        pairs_out.open(r.pairs_file, std::ios::out | std::ios::trunc);
+        if (!pairs_out) {
+            err << "cullide: error: cannot open '" << r.pairs_file << "' for writing\n";
+            return 1;
+        }
+        pairs_out << "frame,object_a,triangle_a,object_b,triangle_b\n";
+    }
+
+    if (r.json) {
+        out << "{\"scene\": \"" << json_escape(scene_label) << "\", \"method\": \"" << to_string(r.options.method)
+            << "\", \"self\": " << (r.options.self ? "true" : "false") << ", \"frames\": [";
+    } else {
+        out << "cullide run: scene " << scene_label << ", method " << to_string(r.options.method)
+            << (r.options.self ? ", self-collision on" : "") << ", " << frames << " frame"
+            << (frames == 1 ? "" : "s") << "\n";
+    }
+    double total_ms = 0;
+    std::uint64_t total_pairs = 0;
+    for (int f = 0; f < frames; ++f) {
+        Frame frame_objects;
+        if (generator) frame_objects = generator->frame(f);
+        std::span<const Mesh> objects = generator ? std::span<const Mesh>(frame_objects) : file_objects;
+        Result<FrameResult> fr = process_frame(objects, r.options);
+        if (!fr) {
+            if (r.json) out << "]}\n";
+            err << "cullide: error: frame " << f << ": " << fr.error().message << "\n";
+            return 1;
+        }
+        const FrameResult& res = fr.value();
+        const FrameStats& s = res.stats;
+        total_ms += s.time_ms;
+        total_pairs += res.pairs.size();
+        if (r.json) {
+            out << (f ? ", " : "") << "{\"frame\": " << f << ", \"objects\": " << s.objects
+                << ", \"triangles\": " << s.triangles << ", \"triangle_pairs\": " << res.pairs.size()
+                << ", \"object_pairs\": " << res.object_pairs.size()
+                << ", \"candidate_triangles\": " << s.candidate_triangles << ", \"exact_tests\": " << s.exact_tests
+                << ", \"adjacent_skipped\": " << s.adjacent_skipped << ", \"time_ms\": " << std::fixed
+                << std::setprecision(3) << s.time_ms << std::defaultfloat << "}";
+        } else {
+            out << "frame " << f << ": " << s.objects << " objects, " << s.triangles << " triangles -> "
+                << res.pairs.size() << " colliding triangle pairs, " << res.object_pairs.size()
+                << " object pairs (" << s.candidate_triangles << " candidate triangles, " << s.exact_tests
+                << " exact tests) " << std::fixed << std::setprecision(2) << s.time_ms << " ms"
+                << std::defaultfloat << "\n";
+        }
+        if (pairs_out.is_open()) {
+            for (const TrianglePair& p : res.pairs) {
+                pairs_out << f << ',' << p.object_a << ',' << p.triangle_a << ',' << p.object_b << ','
+                          << p.triangle_b << '\n';
+            }
+        }
+    }
+    if (r.json) {
+        out << "]}\n";
+    } else {
+        out << "total: " << total_pairs << " colliding triangle pairs in " << frames << " frame"
+            << (frames == 1 ? "" : "s") << ", " << std::fixed << std::setprecision(2)
+            << total_ms / frames << " ms per frame" << std::defaultfloat << "\n";
+    }
+    if (pairs_out.is_open()) {
+        pairs_out.close();
+        if (!pairs_out) {
+            err << "cullide: error: writing '" << r.pairs_file << "' failed\n";
+            return 1;
+        }
+    }
+    return 0;
+}
+
+}  // namespace
+
+int run(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+    try {
+        if (args.empty() || args[0] == "help" || args[0] == "--help" || args[0] == "-h") {
+            (args.empty() ? err : out) << kUsage;
+            return args.empty() ? 2 : 0;
+        }
+        if (args[0] == "scenes") {
+            SceneOptions defaults;
+            for (const std::string& name : scene_names()) {
+                Result<std::unique_ptr<SceneGenerator>> g = make_scene(name, defaults);
+                out << name << ": " << (g ? g.value()->description() : g.error().message) << "\n";
+            }
+            return 0;
+        }
+        if (args[0] == "run") return run_command(args, out, err);
+        throw UsageError{"unknown command '" + args[0] + "'"};
+    } catch (const UsageError& e) {
+        err << "cullide: " << e.message << "\n(run 'cullide help' for usage)\n";
+        return 2;
+    }
+}
+
+}  // namespace cullide::cli

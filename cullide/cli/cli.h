@@ -1,0 +1,14 @@
+// The `cullide` command line, as a function so tests can drive it without a process.
+#pragma once
+
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace cullide::cli {
+
+// Runs the command line `args` (without the program name). Results go to `out`, errors to `err`.
+// Returns the exit status: 0 success, 1 bad input or failed run, 2 bad usage.
+int run(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+
+}  // namespace cullide::cli

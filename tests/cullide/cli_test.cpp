@@ -1,0 +1,144 @@
+// The CLI contract: options, errors, exit codes, the CSV pair file and the JSON document.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli.h"
+#include "cullide/pipeline.h"
+#include "cullide/scenes.h"
+
+namespace {
+
+struct Outcome {
+    int status;
+    std::string out, err;
+};
+
+Outcome run(std::vector<std::string> args) {
+    std::ostringstream out, err;
+    int status = cullide::cli::run(args, out, err);
+    return {status, out.str(), err.str()};
+}
+
+std::string read_file(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+std::filesystem::path temp_path(const std::string& name) {
+    return std::filesystem::temp_directory_path() / ("cullide_cli_test_" + name);
+}
+
+}  // namespace
+
+TEST_CASE("usage errors exit with status 2 and say what is wrong") {
+    Outcome o = run({});
+    CHECK(o.status == 2);
+    CHECK(o.err.find("usage: cullide") != std::string::npos);
+
+    o = run({"frobnicate"});
+    CHECK(o.status == 2);
+    CHECK(o.err.find("unknown command 'frobnicate'") != std::string::npos);
+
+    o = run({"run", "--bogus"});
+    CHECK(o.status == 2);
+    CHECK(o.err.find("unknown option '--bogus'") != std::string::npos);
+
+    o = run({"run", "--frames", "0"});
+    CHECK(o.status == 2);
+    CHECK(o.err.find("--frames must be an integer in 1..1000000 (got '0')") != std::string::npos);
+
+    o = run({"run", "--frames", "3x"});
+    CHECK(o.status == 2);
+    o = run({"run", "--threads", "-1"});
+    CHECK(o.status == 2);
+    o = run({"run", "--resolution", "99999"});
+    CHECK(o.status == 2);
+    o = run({"run", "--scale", "nan"});
+    CHECK(o.status == 2);
+    o = run({"run", "--method", "magic"});
+    CHECK(o.status == 2);
+    CHECK(o.err.find("unknown method 'magic' (valid: exact") != std::string::npos);
+    o = run({"run", "--pairs"});
+    CHECK(o.status == 2);
+    CHECK(o.err.find("option --pairs needs a value") != std::string::npos);
+    CHECK(o.out.empty());
+}
+
+TEST_CASE("a missing mesh file is an input error naming the file") {
+    Outcome o = run({"run", "/nonexistent/dir/x.obj"});
+    CHECK(o.status == 1);
+    CHECK(o.err.find("/nonexistent/dir/x.obj") != std::string::npos);
+}
+
+TEST_CASE("an unwritable pair file is an error before any frame runs") {
+    Outcome o = run({"run", "--scale", "0.05", "--frames", "1", "--pairs", "/nonexistent/dir/p.csv"});
+    CHECK(o.status == 1);
+    CHECK(o.err.find("cannot open '/nonexistent/dir/p.csv' for writing") != std::string::npos);
+    CHECK(o.out.empty());
+}
+
+TEST_CASE("the pair file holds exactly the library's pairs, frame by frame, sorted, with the header") {
+    const auto csv = temp_path("pairs.csv");
+    Outcome o = run({"run", "cylinders", "--frames", "3", "--threads", "2", "--pairs", csv.string()});
+    REQUIRE(o.status == 0);
+    CHECK(o.out.find("frame 2:") != std::string::npos);
+
+    std::ostringstream expected;
+    expected << "frame,object_a,triangle_a,object_b,triangle_b\n";
+    auto scene = cullide::make_scene("cylinders", {});
+    REQUIRE(scene.ok());
+    std::size_t rows = 0;
+    for (int f = 0; f < 3; ++f) {
+        cullide::Frame objects = scene.value()->frame(f);
+        auto r = cullide::process_frame(objects, {});
+        REQUIRE(r.ok());
+        for (const auto& p : r.value().pairs) {
+            expected << f << ',' << p.object_a << ',' << p.triangle_a << ',' << p.object_b << ',' << p.triangle_b
+                     << '\n';
+            ++rows;
+        }
+    }
+    CHECK(rows > 0);  // the default scene must have collisions, or this test proves little
+    CHECK(read_file(csv) == expected.str());
+    std::filesystem::remove(csv);
+}
+
+TEST_CASE("--json prints one document with a record per frame") {
+    Outcome o = run({"run", "--scale", "0.1", "--frames", "2", "--json"});
+    REQUIRE(o.status == 0);
+    CHECK(o.out.rfind("{\"scene\": \"cylinders\", \"method\": \"exact\"", 0) == 0);
+    CHECK(o.out.find("{\"frame\": 0,") != std::string::npos);
+    CHECK(o.out.find("{\"frame\": 1,") != std::string::npos);
+    CHECK(o.out.find("{\"frame\": 2,") == std::string::npos);
+    CHECK(o.out.substr(o.out.size() - 3) == "]}\n");
+}
+
+TEST_CASE("mesh files are objects in argument order and --self reports pairs inside one object") {
+    const auto path = temp_path("fold.obj");
+    {
+        std::ofstream f(path);
+        // Two triangles of one object crossing each other, sharing no vertex.
+        f << "v 0 0 0\nv 2 0 0\nv 0 2 0\nv 0.5 0.5 -1\nv 0.5 0.5 1\nv 3 3 0\nf 1 2 3\nf 4 5 6\n";
+    }
+    Outcome plain = run({"run", path.string()});
+    REQUIRE(plain.status == 0);
+    CHECK(plain.out.find("-> 0 colliding triangle pairs") != std::string::npos);
+    Outcome self = run({"run", path.string(), "--self"});
+    REQUIRE(self.status == 0);
+    CHECK(self.out.find("-> 1 colliding triangle pairs, 1 object pairs") != std::string::npos);
+    std::filesystem::remove(path);
+}
+
+TEST_CASE("the README's library example is the file the build compiles") {
+    const std::string readme = read_file(std::filesystem::path(CULLIDE_SOURCE_DIR) / "README.md");
+    const std::string example = read_file(std::filesystem::path(CULLIDE_SOURCE_DIR) / "tests/cullide/readme_example.cpp");
+    REQUIRE_FALSE(example.empty());
+    CHECK(readme.find(example) != std::string::npos);
+}
