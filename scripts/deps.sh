@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages cullide needs, only those missing (so a second run does nothing).
+# usage: scripts/deps.sh run|test|fuzz
+#   run   what the library and the CLI need
+#   test  + the test and benchmark dependencies and the oracles (doctest, GMP, OSMesa, Embree, Benchmark)
+#   fuzz  + clang with libFuzzer
+set -euo pipefail
+
+want=(cmake ninja-build g++ pkg-config libeigen3-dev libtbb-dev)
+case "${1:-run}" in
+  run) ;;
+  test) want+=(doctest-dev libgmp-dev libosmesa6-dev libembree-dev libbenchmark-dev) ;;
+  fuzz) want+=(doctest-dev libgmp-dev libosmesa6-dev libembree-dev libbenchmark-dev clang libclang-rt-14-dev) ;;
+  *) echo "usage: $0 run|test|fuzz" >&2; exit 2 ;;
+esac
+
+missing=()
+for p in "${want[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+echo "cullide: installing missing packages: ${missing[*]}"
+if [ "$(id -u)" -ne 0 ]; then
+  echo "cullide: these packages are missing and installing them needs root: ${missing[*]}" >&2
+  exit 1
+fi
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
