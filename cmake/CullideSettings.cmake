@@ -24,6 +24,17 @@ if(CULLIDE_SANITIZE)
   add_link_options(-fsanitize=${CULLIDE_SANITIZE})
 endif()
 
+# Fuzzing: every target in the tree (the libraries above all) gets coverage instrumentation and
+# ASan + UBSan, or libFuzzer would only see the fuzz target's own file. Fuzz targets add the
+# libFuzzer main themselves (fuzz/CMakeLists.txt).
+if(CULLIDE_BUILD_FUZZERS)
+  if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
+    message(FATAL_ERROR "CULLIDE_BUILD_FUZZERS needs clang (configure with -DCMAKE_CXX_COMPILER=clang++)")
+  endif()
+  add_compile_options(-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer)
+  add_link_options(-fsanitize=address,undefined)
+endif()
+
 # One call for every project target.
 function(cullide_target_defaults target)
   target_link_libraries(${target} PRIVATE cullide::warnings cullide::fp)

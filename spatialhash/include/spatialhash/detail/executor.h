@@ -1,0 +1,52 @@
+// spatialhash/detail/executor.h: the one place where work is spread over threads.
+//
+// Callers cut their work into a fixed number of items that does not depend on the thread count
+// (chunks of kChunk elements) and merge per-item results in item order, so every output is
+// identical for any thread count. With oneTBB (CULLIDE_HAVE_TBB) items run in a
+// tbb::task_arena of the requested size; without it they run serially in order. No TBB type
+// appears here.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <type_traits>
+
+namespace spatialhash::detail {
+
+// Elements per work item. Fixed, so that chunk boundaries never depend on the thread count.
+inline constexpr std::size_t kChunk = std::size_t{1} << 14;
+
+[[nodiscard]] constexpr std::size_t chunk_count(std::size_t n, std::size_t chunk = kChunk) {
+    return (n + chunk - 1) / chunk;
+}
+
+class Executor {
+   public:
+    // threads = 0: all hardware threads. 1: serial in the calling thread.
+    explicit Executor(unsigned threads);
+    ~Executor();
+    Executor(const Executor&) = delete;
+    Executor& operator=(const Executor&) = delete;
+
+    [[nodiscard]] unsigned concurrency() const { return concurrency_; }
+
+    // Calls f(i) once for every i in [0, count), possibly concurrently, and returns when all are
+    // done. f must only write state owned by item i.
+    template <class F>
+    void for_each(std::size_t count, F&& f) {
+        run(count, &invoke<std::remove_reference_t<F>>, static_cast<void*>(&f));
+    }
+
+   private:
+    template <class F>
+    static void invoke(void* ctx, std::size_t i) {
+        (*static_cast<F*>(ctx))(i);
+    }
+    void run(std::size_t count, void (*fn)(void*, std::size_t), void* ctx);
+
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+    unsigned concurrency_ = 1;
+};
+
+}  // namespace spatialhash::detail

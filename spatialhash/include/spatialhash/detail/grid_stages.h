@@ -1,0 +1,173 @@
+// spatialhash/detail/grid_stages.h: the stages of the uniform-grid broad phase, one function each,
+// exposed for the tests. Algorithm: GPU Gems 3 ch. 32 (S. Le Grand, "Broad-Phase Collision
+// Detection with CUDA", 2007); the CPU port, the key layout and the outlier handling are ours.
+// docs/spatialhash.md explains every stage and why it is correct.
+//
+//   plan_grid            bounding spheres -> cell size, origin, key layout, huge (outlier) objects
+//   build_cell_ids       cell-ID array: 8 slots per object (home first, phantoms, sentinels),
+//                        object array (id << 1 | phantom bit), control bits per object
+//   radix_sort           stable LSD radix sort of (key, value), per-chunk histograms merged in order
+//   build_collision_cells  scan of the sorted keys -> cells with >= 1 H and >= 2 occupants
+//   collide_cells        the 8 passes by cell type with the chapter's duplicate-avoidance rule;
+//                        count -> scan -> fill
+//   collide_huge         huge objects against every object; count -> scan -> fill
+//   sort_pairs           the final canonical order
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "spatialhash/broad_phase.h"
+#include "spatialhash/detail/executor.h"
+#include "spatialhash/result.h"
+
+namespace spatialhash::detail {
+
+inline constexpr int kDims = 3;
+inline constexpr int kSlots = 1 << kDims;  // 2^d cell slots per object
+// The chapter scales bounding spheres by sqrt(2) before finding phantom cells; docs/spatialhash.md
+// proves it enough in any dimension and tests/spatialhash/grid_property_test.cpp checks it.
+inline constexpr double kCoverageScale = 1.4142135623730951;
+// Automatic cell edge = kAutoCellFactor x the largest scaled diameter (the chapter's 1.5).
+inline constexpr double kAutoCellFactor = 1.5;
+// An object belongs in the grid only when cell >= kMinCellFactor x its scaled diameter. The
+// duplicate-avoidance rule needs cell > (2 + sqrt 2) r = 1.207 x the scaled diameter
+// (docs/spatialhash.md); 1.25 leaves room for rounding.
+inline constexpr double kMinCellFactor = 1.25;
+// Automatic sizing: an object whose scaled diameter exceeds kOutlierFactor x the 99th percentile
+// is "huge" and tested apart, so that a few giants do not coarsen the grid for everyone.
+inline constexpr double kOutlierFactor = 8.0;
+inline constexpr double kOutlierQuantile = 0.99;
+// Cell coordinates are measured from the grid origin and must stay at or below 2^50, so that they
+// convert to integers exactly. The padding of bounding spheres (2^-46 x |centre|) already bounds
+// them by about 2^46 for every gridded object (docs/spatialhash.md, "Keys and limits"), so this
+// limit is a guard that valid input does not reach; plan_grid still checks it.
+inline constexpr double kMaxCellCoordinate = 0x1.0p50;
+// Keys keep at most 21 bits per axis; larger coordinates wrap modulo 2^21 (parity is kept, and
+// wrapped cells are 2^21 cells apart, so aliasing adds candidates but never changes the result).
+inline constexpr unsigned kMaxAxisBits = 21;
+
+// A conservative bounding sphere: the object lies inside it even after rounding (the radius is
+// padded by 2^-46 x (radius + max |centre[k]|), see docs/spatialhash.md).
+struct BoundingSphere {
+    double centre[3];
+    double radius;
+};
+
+// Bounding spheres of boxes (centre = box centre, radius = half diagonal, padded) and of spheres
+// (the sphere, padded). Inputs must be valid (find_pairs validates them first).
+[[nodiscard]] std::vector<BoundingSphere> bounding_spheres(std::span<const Box> boxes, Executor& ex);
+[[nodiscard]] std::vector<BoundingSphere> bounding_spheres(std::span<const Sphere> spheres, Executor& ex);
+
+struct GridPlan {
+    double cell_size = 0.0;
+    double origin[3] = {0.0, 0.0, 0.0};
+    unsigned axis_bits = 1;               // b: key = x << 2b | y << b | z
+    std::uint64_t sentinel = 0;           // 2^(3b), above every real key
+    unsigned key_bits = 0;                // 3b + 1: the bits the radix sort must look at
+    std::vector<std::uint8_t> huge;       // per object: 1 = tested apart, not in the grid
+    std::vector<std::uint32_t> huge_ids;  // ascending
+    // Test knobs (the defaults are the library's; tests lower them to show they matter).
+    double coverage_scale = kCoverageScale;
+};
+
+struct PlanKnobs {
+    double coverage_scale = kCoverageScale;
+    double min_cell_factor = kMinCellFactor;
+};
+
+// Chooses the cell edge (requested_cell_size > 0, or automatic when 0), the outliers and the key
+// layout. Fails when a gridded object's cell coordinate would exceed kMaxCellCoordinate, naming it.
+[[nodiscard]] Result<GridPlan> plan_grid(std::span<const BoundingSphere> spheres, double requested_cell_size,
+                                         Executor& ex, const PlanKnobs& knobs = {});
+
+// The cell key of integer cell coordinates (already wrapped to axis_bits), and its type (parity).
+[[nodiscard]] constexpr std::uint64_t cell_key(std::uint64_t x, std::uint64_t y, std::uint64_t z, unsigned b) {
+    return (x << (2 * b)) | (y << b) | z;
+}
+[[nodiscard]] constexpr unsigned cell_type_of_key(std::uint64_t key, unsigned b) {
+    return static_cast<unsigned>(((key >> (2 * b)) & 1U) | (((key >> b) & 1U) << 1) | ((key & 1U) << 2));
+}
+
+// Control bits of one object: bits 0-2 the type of its home cell, bits 3-10 the mask of the cell
+// types it overlaps (home included). 0 for huge objects (they are not in the grid).
+[[nodiscard]] constexpr unsigned home_type(std::uint16_t control) { return control & 7U; }
+[[nodiscard]] constexpr unsigned type_mask(std::uint16_t control) { return (control >> 3) & 0xFFU; }
+
+// Object-array value: object id << 1 | 1 when the entry is a phantom (P), 0 when home (H).
+[[nodiscard]] constexpr std::uint32_t entry_object(std::uint32_t value) { return value >> 1; }
+[[nodiscard]] constexpr bool entry_is_phantom(std::uint32_t value) { return (value & 1U) != 0; }
+
+// Stage 1. Slot-major arrays of kSlots * n entries: entry s * n + i is slot s of object i. Slot 0
+// is the home cell, slots 1.. the phantom cells in (x, y, z) order, the rest hold plan.sentinel.
+// Slot-major layout puts every H entry before every P entry, so a stable sort keeps H first
+// within each cell.
+struct CellIdArray {
+    std::vector<std::uint64_t> cell_ids;
+    std::vector<std::uint32_t> objects;
+    std::vector<std::uint16_t> control;  // per object
+};
+[[nodiscard]] CellIdArray build_cell_ids(std::span<const BoundingSphere> spheres, const GridPlan& plan, Executor& ex);
+
+// Stage 2. Stable LSD radix sort by the low key_bits bits of keys, 8-bit digits; values follow
+// their keys. Digits on which every key agrees are skipped. values may be empty (keys only).
+void radix_sort(std::vector<std::uint64_t>& keys, std::vector<std::uint32_t>& values, unsigned key_bits, Executor& ex);
+
+// Stage 3. One collision cell: entries [start, start + homes + phantoms) of the sorted arrays, H
+// entries first.
+struct CollisionCell {
+    std::uint32_t start;
+    std::uint32_t homes;
+    std::uint32_t phantoms;
+    std::uint32_t type;
+};
+struct CollisionCells {
+    std::vector<CollisionCell> cells;  // in key order
+    std::uint64_t entries = 0;         // non-sentinel entries
+};
+[[nodiscard]] CollisionCells build_collision_cells(std::span<const std::uint64_t> sorted_keys,
+                                                   std::span<const std::uint32_t> sorted_objects,
+                                                   const GridPlan& plan, Executor& ex);
+
+// The exact test between objects i and j of the caller's input.
+struct Objects {
+    std::span<const Box> boxes;      // exactly one of boxes / spheres is non-empty (or both empty)
+    std::span<const Sphere> spheres;
+    [[nodiscard]] std::size_t size() const { return boxes.empty() ? spheres.size() : boxes.size(); }
+    [[nodiscard]] bool overlap(std::uint32_t i, std::uint32_t j) const {
+        return boxes.empty() ? overlaps(spheres[i], spheres[j]) : overlaps(boxes[i], boxes[j]);
+    }
+};
+
+// The chapter's rule: in a pass over cells of type t, skip a pair when, for x in {a, b}, the type
+// T of x's home cell is < t and both objects overlap a cell of type T (they then share x's home,
+// where the pair was tested in pass T).
+[[nodiscard]] constexpr bool tested_in_earlier_pass(std::uint16_t ca, std::uint16_t cb, unsigned t) {
+    const unsigned both = type_mask(ca) & type_mask(cb);
+    const unsigned ta = home_type(ca);
+    const unsigned tb = home_type(cb);
+    return (ta < t && ((both >> ta) & 1U) != 0) || (tb < t && ((both >> tb) & 1U) != 0);
+}
+
+// Stages 4-5. The 2^d passes, one per cell type; in a cell each H entry is tested against every
+// later entry (never P-P). Pairs come out with a < b, pass by pass, cells in key order; they are
+// not yet sorted. candidate_tests receives the number of exact tests.
+[[nodiscard]] std::vector<Pair> collide_cells(const CollisionCells& cells, std::span<const std::uint32_t> sorted_objects,
+                                              std::span<const std::uint16_t> control, const Objects& objects,
+                                              Executor& ex, std::uint64_t* candidate_tests = nullptr);
+
+// Huge objects against every object (each pair once), count -> scan -> fill.
+[[nodiscard]] std::vector<Pair> collide_huge(std::span<const std::uint32_t> huge_ids, std::span<const std::uint8_t> huge,
+                                             const Objects& objects, Executor& ex,
+                                             std::uint64_t* candidate_tests = nullptr);
+
+// Sorts pairs by (a, b) (radix sort on a << 32 | b).
+void sort_pairs(std::vector<Pair>& pairs, std::size_t object_count, Executor& ex);
+
+// The whole grid pipeline on validated input (find_pairs calls it after validation).
+[[nodiscard]] Result<PairSet> grid_find_pairs(const Objects& objects, std::span<const BoundingSphere> spheres,
+                                              double requested_cell_size, Executor& ex, const PlanKnobs& knobs = {});
+
+}  // namespace spatialhash::detail

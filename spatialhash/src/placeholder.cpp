@@ -1,1 +1,0 @@
-namespace spatialhash { int placeholder() { return 0; } }  // replaced by the spatialhash module
