@@ -18,6 +18,14 @@ if(CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
   target_compile_options(cullide_fp INTERFACE -fno-unsafe-math-optimizations)
 endif()
 
+# GCC 12's SLP vectorizer drops float rounding: Vec3{double(float(x)), double(float(y)), ...} comes
+# out as a plain copy of x and y at -O2 (found by the Embree oracle; pinned by mesh_test, "the
+# compiler keeps double -> float -> double rounding"). Rounding to float is part of the raster and
+# oracle contracts, so SLP vectorization is off for the affected compilers.
+if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_LESS 13)
+  target_compile_options(cullide_fp INTERFACE -fno-tree-slp-vectorize)
+endif()
+
 # Sanitizers, applied to everything built in this tree when CULLIDE_SANITIZE is set.
 if(CULLIDE_SANITIZE)
   add_compile_options(-fsanitize=${CULLIDE_SANITIZE} -fno-omit-frame-pointer -fno-sanitize-recover=all)

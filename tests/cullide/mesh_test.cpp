@@ -61,3 +61,21 @@ TEST_CASE("touching boxes overlap, separated boxes do not") {
     CHECK_FALSE(cullide::overlaps(a, c));
     CHECK(cullide::Aabb{}.empty());
 }
+
+namespace {
+// Not inlined, so the compiler must compile the conversion as written, for an unknown argument.
+[[gnu::noinline]] cullide::Vec3 round_to_float(const cullide::Vec3& v) {
+    return {static_cast<double>(static_cast<float>(v.x)), static_cast<double>(static_cast<float>(v.y)),
+            static_cast<double>(static_cast<float>(v.z))};
+}
+}  // namespace
+
+TEST_CASE("the compiler keeps double -> float -> double rounding in every component (GCC 12 SLP bug guard)") {
+    // g++ 12.2 -O2 with SLP vectorization turns this into a copy of x and y (cmake/CullideSettings.cmake).
+    volatile double scale = 1.0;  // keeps the inputs unknown at compile time
+    const cullide::Vec3 v{0.1 * scale, 0.2 * scale, 0.3 * scale};
+    const cullide::Vec3 r = round_to_float(v);
+    CHECK(r.x == 0.100000001490116119384765625);
+    CHECK(r.y == 0.20000000298023223876953125);
+    CHECK(r.z == 0.300000011920928955078125);
+}
