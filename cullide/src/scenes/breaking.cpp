@@ -118,7 +118,11 @@ class BreakingScene final : public SceneGenerator {
             const Rotation rot = rotation_about(c.spin_axis, c.spin_rate * since_break);
             const Vec3 drift =
                 (c.speed * since_break) * c.direction + Vec3{0, 0, -0.5 * kGravity * since_break * since_break};
-            for (Vec3& p : m.positions) p = (c.centre + apply(rot, p - c.centre)) + drift;
+            // At rest the pieces must meet exactly along their seams: c + (p - c) is not p in floating
+            // point, so the rest positions are used as they are until the break.
+            if (since_break > 0) {
+                for (Vec3& p : m.positions) p = (c.centre + apply(rot, p - c.centre)) + drift;
+            }
             out.push_back(std::move(m));
         }
         Mesh ball = ball_;
