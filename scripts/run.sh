@@ -11,8 +11,11 @@ if [ ! -f "$build/CMakeCache.txt" ]; then
   cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCULLIDE_BUILD_TESTS=OFF \
     -DCULLIDE_BUILD_BENCHMARKS=OFF -DCULLIDE_WITH_OSMESA=OFF -DCULLIDE_WITH_EMBREE=OFF >/dev/null
 fi
-cmake --build "$build" --target cullide_cli -j"$(nproc)" | grep -v '^\[' || true
-test -x "$build/bin/cullide"
+if ! cmake --build "$build" --target cullide_cli -j"$(nproc)" > "$build/build.log" 2>&1; then
+  cat "$build/build.log" >&2
+  echo "cullide: the build failed (log above)" >&2
+  exit 1
+fi
 # Relative scene paths are taken from where the user stood, not from the repo root.
 cd "$OLDPWD" 2>/dev/null || true
 exec "$build/bin/cullide" run "$@"
