@@ -7,7 +7,6 @@
 // anyway) is produced by the same steps for any thread count.
 #include <algorithm>
 #include <cassert>
-#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -16,9 +15,10 @@
 namespace spatialhash::detail {
 
 namespace {
-constexpr unsigned kDigitBits = 8;
-constexpr std::size_t kBins = std::size_t{1} << kDigitBits;
-using Histogram = std::array<std::size_t, kBins>;
+// Digits are at most kMaxDigitBits wide, and as wide as needed to cover key_bits in the fewest
+// passes (a 16-bit key takes 2 passes of 8 bits, a 19-bit key 2 passes of 10, not 3 of 8).
+// 2^11 bins of 8 bytes per chunk still sit in L1/L2 next to the chunk.
+constexpr unsigned kMaxDigitBits = 11;
 }  // namespace
 
 void radix_sort(std::vector<std::uint64_t>& keys, std::vector<std::uint32_t>& values, unsigned key_bits,
@@ -26,27 +26,32 @@ void radix_sort(std::vector<std::uint64_t>& keys, std::vector<std::uint32_t>& va
     const std::size_t n = keys.size();
     const bool with_values = !values.empty();
     assert(!with_values || values.size() == n);
+    key_bits = std::min(key_bits, 64U);
     if (n < 2 || key_bits == 0) return;
+    const unsigned passes = (key_bits + kMaxDigitBits - 1) / kMaxDigitBits;
+    const unsigned digit_bits = (key_bits + passes - 1) / passes;
+    const std::size_t bins = std::size_t{1} << digit_bits;
+    const std::uint64_t digit_mask = bins - 1;
     const std::size_t chunks = chunk_count(n);
-    std::vector<Histogram> hist(chunks);
+    std::vector<std::size_t> hist(chunks * bins);  // chunk c's bins at [c * bins, (c + 1) * bins)
     std::vector<std::uint64_t> keys_tmp(n);
     std::vector<std::uint32_t> values_tmp(with_values ? n : 0);
 
-    for (unsigned shift = 0; shift < key_bits && shift < 64; shift += kDigitBits) {
+    for (unsigned shift = 0; shift < key_bits; shift += digit_bits) {
         ex.for_each(chunks, [&](std::size_t c) {
-            Histogram& h = hist[c];
-            h.fill(0);
+            std::size_t* h = hist.data() + c * bins;
+            std::fill(h, h + bins, std::size_t{0});
             const std::size_t end = std::min(n, (c + 1) * kChunk);
-            for (std::size_t i = c * kChunk; i < end; ++i) ++h[(keys[i] >> shift) & (kBins - 1)];
+            for (std::size_t i = c * kChunk; i < end; ++i) ++h[(keys[i] >> shift) & digit_mask];
         });
         // Merge in (digit, chunk) order: the offsets that make the scatter stable.
         std::size_t running = 0;
         bool all_one_digit = false;
-        for (std::size_t d = 0; d < kBins; ++d) {
+        for (std::size_t d = 0; d < bins; ++d) {
             std::size_t digit_total = 0;
             for (std::size_t c = 0; c < chunks; ++c) {
-                const std::size_t count = hist[c][d];
-                hist[c][d] = running;
+                const std::size_t count = hist[c * bins + d];
+                hist[c * bins + d] = running;
                 running += count;
                 digit_total += count;
             }
@@ -54,10 +59,10 @@ void radix_sort(std::vector<std::uint64_t>& keys, std::vector<std::uint32_t>& va
         }
         if (all_one_digit) continue;  // every key has this digit: the pass would be the identity
         ex.for_each(chunks, [&](std::size_t c) {
-            Histogram& offset = hist[c];
+            std::size_t* offset = hist.data() + c * bins;
             const std::size_t end = std::min(n, (c + 1) * kChunk);
             for (std::size_t i = c * kChunk; i < end; ++i) {
-                const std::size_t dst = offset[(keys[i] >> shift) & (kBins - 1)]++;
+                const std::size_t dst = offset[(keys[i] >> shift) & digit_mask]++;
                 keys_tmp[dst] = keys[i];
                 if (with_values) values_tmp[dst] = values[i];
             }

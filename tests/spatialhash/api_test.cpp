@@ -179,12 +179,25 @@ TEST_CASE("every method fills the statistics it owns") {
     CHECK(g.value().stats.cell_size > 0);
     CHECK(g.value().stats.cell_entries >= boxes.size());
     CHECK(g.value().stats.collision_cells > 0);
-    CHECK(g.value().stats.candidate_tests >= g.value().pairs.size());
+    // The grid's cells propose every reported pair; the float tests decide most of them, so the
+    // exact tests are at most the proposals.
+    CHECK(g.value().stats.cell_pairs >= g.value().pairs.size());
+    CHECK(g.value().stats.candidate_tests <= g.value().stats.cell_pairs);
     CHECK(s.value().stats.sweep_axis >= 0);
     CHECK(b.value().stats.candidate_tests == 500ULL * 499 / 2);
-    // Both fast methods test far fewer pairs than brute force.
-    CHECK(g.value().stats.candidate_tests < b.value().stats.candidate_tests / 4);
+    // Both fast methods consider far fewer pairs than brute force.
+    CHECK(g.value().stats.cell_pairs < b.value().stats.candidate_tests / 4);
     CHECK(s.value().stats.candidate_tests < b.value().stats.candidate_tests / 4);
+    // Spheres: no float test can accept a pair, so every reported pair had its exact test.
+    std::vector<Sphere> spheres;
+    for (const Box& x : boxes) {
+        spheres.push_back(Sphere{{0.5 * x.lo[0] + 0.5 * x.hi[0], 0.5 * x.lo[1] + 0.5 * x.hi[1], 0.5 * x.lo[2] + 0.5 * x.hi[2]},
+                                 0.5 * (x.hi[0] - x.lo[0])});
+    }
+    auto gs = spatialhash::find_pairs(std::span<const Sphere>(spheres));
+    REQUIRE(gs.ok());
+    CHECK(!gs.value().pairs.empty());
+    CHECK(gs.value().stats.candidate_tests >= gs.value().pairs.size());
 }
 
 TEST_CASE("boxes and spheres near 1e-300 keep their size (fuzzer finding: squared edges underflowed)") {
@@ -211,5 +224,35 @@ TEST_CASE("boxes and spheres near 1e-300 keep their size (fuzzer finding: square
         REQUIRE(r.ok());
         CHECK(r.value().pairs == reference_pairs(spheres));
         CHECK(r.value().pairs == std::vector<Pair>{{1, 2}, {1, 3}, {2, 3}});
+    }
+}
+
+TEST_CASE("coordinates near the ends of the double range do not overflow the cell arithmetic (fuzzer finding)") {
+    // Objects at -1.7e308 and +1.7e308: x - origin overflowed to inf and the grid refused input
+    // that the other methods accept. An object whose coverage box reaches past -DBL_MAX cannot sit
+    // in cells at all and is tested apart.
+    constexpr double kMax = std::numeric_limits<double>::max();
+    const std::vector<Box> boxes = {
+        Box{{-1.7e308, 0, 0}, {-1.7e308 + 1e300, 1e300, 1e300}},
+        Box{{1.7e308 - 1e300, 0, 0}, {1.7e308, 1e300, 1e300}},
+        Box{{-1.7e308 + 5e299, 5e299, 5e299}, {-1.7e308 + 1.5e300, 1.5e300, 1.5e300}},
+        Box{{-kMax, 0, 0}, {-1.7e308 + 1e299, 2e300, 2e300}},
+        Box{{1.7e308 - 2e300, 5e299, 0}, {1.7e308 - 5e299, 6e299, 1e299}},
+        Box{{0, 0, 0}, {1e300, 1e300, 1e300}},
+    };
+    const std::vector<Pair> want = reference_pairs(boxes);
+    // (0, 2) and (1, 4) near the two ends, (0, 3) with the object that reaches -DBL_MAX.
+    REQUIRE(want == std::vector<Pair>{{0, 2}, {0, 3}, {1, 4}});
+    // 1e308: a cell large enough for every object, so only the coverage rule sets object 3 apart.
+    for (double cell : {0.0, 1e301, 1e308}) {
+        for (Method m : {Method::SpatialHash, Method::SweepAndPrune, Method::BruteForce}) {
+            Options o = with(m);
+            o.cell_size = cell;
+            auto r = spatialhash::find_pairs(std::span<const Box>(boxes), o);
+            CAPTURE(cell);
+            CAPTURE(static_cast<int>(m));
+            REQUIRE_MESSAGE(r.ok(), (r.ok() ? "" : r.error().message));
+            CHECK(r.value().pairs == want);
+        }
     }
 }

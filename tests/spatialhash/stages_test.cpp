@@ -186,7 +186,7 @@ TEST_CASE("the passes report each overlapping pair once, before the final sort")
         d::radix_sort(ids.cell_ids, ids.objects, planned.value().key_bits, ex);
         const d::CollisionCells cells = d::build_collision_cells(ids.cell_ids, ids.objects, planned.value(), ex);
         const d::Objects objects{{}, s};
-        std::vector<Pair> raw = d::collide_cells(cells, ids.objects, ids.control, objects, ex);
+        std::vector<Pair> raw = d::collide_cells(cells, ids.objects, ids.control, objects, d::filter_boxes(objects, bs, ex), ex);
         for (const Pair& p : raw) CHECK(p.a < p.b);
         std::vector<Pair> sorted = raw;
         d::sort_pairs(sorted, s.size(), ex);
@@ -279,4 +279,126 @@ TEST_CASE("the key-limit guard names the object when a cell coordinate would pas
     CHECK(planned.error().message ==
           "spatial hash: object 1 lies 4503599627370496 cells from the grid origin on axis 1, beyond the limit "
           "2^50 (cell size 1); pass a larger Options::cell_size or use Method::SweepAndPrune");
+}
+
+TEST_CASE("build_cell_entries equals build_cell_ids without its sentinels, for any thread count") {
+    Rng rng(41);
+    for (int round = 0; round < 12; ++round) {
+        // Up to 40K objects (3 chunks), some large enough to be huge, so chunks and slots both vary.
+        const std::size_t n = round == 0 ? 0 : (round == 1 ? 1 : 100 + rng.below(40000));
+        std::vector<Sphere> s;
+        for (std::size_t i = 0; i < n; ++i) {
+            const double r = rng.below(500) == 0 ? 5.0 : rng.range(0.0, 0.3);
+            s.push_back(Sphere{{rng.range(-20, 20), rng.range(-20, 20), rng.range(0, 9)}, r});
+        }
+        const auto bs = spheres_of(s);
+        for (unsigned threads : {1U, 2U, 3U}) {
+            d::Executor ex(threads);
+            auto planned = d::plan_grid(bs, 0.0, ex);
+            REQUIRE(planned.ok());
+            d::CellIdArray want = d::build_cell_ids(bs, planned.value(), ex);
+            d::drop_sentinels(want, planned.value(), ex);
+            const d::CellIdArray got = d::build_cell_entries(bs, planned.value(), ex);
+            CAPTURE(round);
+            CAPTURE(threads);
+            CHECK(got.cell_ids == want.cell_ids);
+            CHECK(got.objects == want.objects);
+            CHECK(got.control == want.control);
+            // drop_sentinels itself: exactly the non-sentinel entries, in their order.
+            const d::CellIdArray full = d::build_cell_ids(bs, planned.value(), ex);
+            std::vector<std::uint64_t> kept;
+            for (std::uint64_t key : full.cell_ids) {
+                if (key != planned.value().sentinel) kept.push_back(key);
+            }
+            CHECK(want.cell_ids == kept);
+        }
+    }
+}
+
+TEST_CASE("float filter boxes: outer boxes never miss an overlapping pair, inner boxes never claim a false one") {
+    // Coordinates that float cannot hold exactly, at every magnitude (subnormal to beyond FLT_MAX),
+    // and partners placed one double ulp inside, on, or one ulp outside each other's faces.
+    Rng rng(51);
+    const double scales[] = {1e-310, 1e-300, 1e-40, 1e-6, 1.0, 3.3e7, 1e20, 3.4028234663852886e38, 1e39, 1e300};
+    std::size_t outer_hits = 0, inner_hits = 0, overlapping = 0;
+    for (double scale : scales) {
+        std::vector<Box> boxes;
+        for (int i = 0; i < 150; ++i) {
+            Box b{};
+            for (int k = 0; k < 3; ++k) {
+                b.lo[k] = scale * rng.range(-1.0, 1.0);
+                b.hi[k] = b.lo[k] + scale * rng.range(0.0, 0.3);
+            }
+            boxes.push_back(b);
+            // A partner that meets b on axis 0 at b.hi[0], nudged by -1, 0 or +1 ulp.
+            Box p = b;
+            const int nudge = static_cast<int>(rng.below(3)) - 1;
+            double face = b.hi[0];
+            if (nudge < 0) face = std::nextafter(face, -INFINITY);
+            if (nudge > 0) face = std::nextafter(face, INFINITY);
+            p.lo[0] = face;
+            p.hi[0] = face + scale * 0.1;
+            boxes.push_back(p);
+        }
+        d::Executor ex(2);
+        const d::Objects objects{boxes, {}};
+        const auto bs = d::bounding_spheres(std::span<const Box>(boxes), ex);
+        const std::vector<d::FilterBox> f = d::filter_boxes(objects, bs, ex);
+        for (std::size_t i = 0; i < boxes.size(); ++i) {
+            for (std::size_t j = i + 1; j < boxes.size(); ++j) {
+                const bool exact = ref_overlap(boxes[i], boxes[j]);
+                CAPTURE(scale);
+                CAPTURE(i);
+                CAPTURE(j);
+                if (exact) CHECK(d::outer_overlap(f[i], f[j]));
+                if (d::inner_overlap(f[i], f[j])) CHECK(exact);
+                // Where float cannot resolve the scale (below its normal range, beyond FLT_MAX)
+                // the float boxes are useless but still safe; count the useful range only.
+                if (scale < 1e-6 || scale > 1e20) continue;
+                overlapping += exact ? 1 : 0;
+                outer_hits += d::outer_overlap(f[i], f[j]) ? 1 : 0;
+                inner_hits += d::inner_overlap(f[i], f[j]) ? 1 : 0;
+            }
+        }
+    }
+    // In float's range the tests decide most pairs: the outer test does not pass everything, and
+    // the inner test accepts the pairs that overlap by more than float rounding (about half here:
+    // the other half are the partners built to touch within one double ulp, left to the exact test).
+    CHECK(overlapping > 300);
+    CHECK(inner_hits > overlapping / 3);
+    CHECK(outer_hits < 3 * overlapping);
+}
+
+TEST_CASE("float filter boxes of spheres contain every pair the sphere predicate accepts, and never decide one") {
+    Rng rng(61);
+    for (double scale : {1e-300, 1e-3, 1.0, 1e9, 1e140}) {
+        std::vector<Sphere> s;
+        for (int i = 0; i < 120; ++i) {
+            const Sphere a{{scale * rng.range(-1, 1), scale * rng.range(-1, 1), scale * rng.range(-1, 1)}, scale * rng.range(0, 0.2)};
+            s.push_back(a);
+            // A tangent partner along a random axis: centres exactly r_a + r_b apart on it.
+            Sphere b = a;
+            b.radius = scale * rng.range(0, 0.2);
+            b.centre[rng.below(3)] += a.radius + b.radius;
+            s.push_back(b);
+        }
+        d::Executor ex(1);
+        const d::Objects objects{{}, s};
+        const auto bs = d::bounding_spheres(std::span<const Sphere>(s), ex);
+        const std::vector<d::FilterBox> f = d::filter_boxes(objects, bs, ex);
+        std::size_t overlapping = 0;
+        for (std::size_t i = 0; i < s.size(); ++i) {
+            for (std::size_t j = i + 1; j < s.size(); ++j) {
+                CAPTURE(scale);
+                CAPTURE(i);
+                CAPTURE(j);
+                if (ref_overlap(s[i], s[j])) {
+                    ++overlapping;
+                    CHECK(d::outer_overlap(f[i], f[j]));
+                }
+                CHECK_FALSE(d::inner_overlap(f[i], f[j]));
+            }
+        }
+        CHECK(overlapping >= 100);
+    }
 }

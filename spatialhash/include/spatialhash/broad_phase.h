@@ -64,7 +64,8 @@ struct Stats {
     std::uint32_t huge_objects = 0;     // SpatialHash: objects tested apart (too large for the grid)
     std::uint64_t cell_entries = 0;     // SpatialHash: home + phantom entries (non-sentinel)
     std::uint64_t collision_cells = 0;  // SpatialHash: cells with >= 1 home and >= 2 occupants
-    std::uint64_t candidate_tests = 0;  // all methods: exact overlap tests performed
+    std::uint64_t cell_pairs = 0;       // SpatialHash: H-H and H-P pairs its cells propose (before any test)
+    std::uint64_t candidate_tests = 0;  // all methods: exact (double) overlap tests performed
     int sweep_axis = -1;                // SweepAndPrune: the axis swept
 };
 
