@@ -16,6 +16,15 @@ void CommandBatch::draw(MeshView mesh, const DrawState& state) {
     commands_.push_back(c);
 }
 
+void CommandBatch::draw(MeshViewD mesh, const DrawState& state) {
+    Command c;
+    c.kind = Command::Kind::Draw;
+    c.mesh_d = mesh;
+    c.double_input = true;
+    c.state = state;
+    commands_.push_back(c);
+}
+
 std::uint32_t CommandBatch::begin_query(QueryKind kind) {
     const auto index = static_cast<std::uint32_t>(query_kinds_.size());
     query_kinds_.push_back(kind);
@@ -43,6 +52,16 @@ namespace {
 bool finite4(const Float4& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && std::isfinite(v.w);
 }
+
+// The exact-bounds rules for one vertex (floats are checked after their exact widening to double).
+std::string check_exact_bounds_vertex(double x, double y, double z, double w) {
+    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z) || !std::isfinite(w)) return "is not finite";
+    if (w != 1.0) return "has w = " + std::to_string(w) + " (the exact-bounds mode takes orthographic input, w = 1)";
+    if (std::fabs(x) > kMaxExactBoundsCoordinate || std::fabs(y) > kMaxExactBoundsCoordinate ||
+        std::fabs(z) > kMaxExactBoundsCoordinate)
+        return "has a coordinate beyond +-2^100 (kMaxExactBoundsCoordinate)";
+    return {};
+}
 std::string cmd_name(std::size_t i) { return "command " + std::to_string(i); }
 }  // namespace
 
@@ -67,12 +86,18 @@ Status validate(const DepthTarget& target, const CommandBatch& batch) {
                 break;
             case Command::Kind::Draw: {
                 const DrawState& s = c.state;
-                if (s.mode != RasterMode::GLExact) return Error{cmd_name(i) + ": unsupported raster mode"};
+                if (s.mode != RasterMode::GLExact && s.mode != RasterMode::ExactBounds)
+                    return Error{cmd_name(i) + ": unsupported raster mode " + std::to_string(static_cast<int>(s.mode))};
+                if (c.double_input && s.mode != RasterMode::ExactBounds)
+                    return Error{cmd_name(i) + ": a double-precision draw (MeshViewD) needs RasterMode::ExactBounds"};
                 if (static_cast<unsigned>(s.depth_func) > static_cast<unsigned>(DepthFunc::Always))
                     return Error{cmd_name(i) + ": invalid depth function"};
                 if (static_cast<unsigned>(s.cull_face) > static_cast<unsigned>(CullFace::Back) ||
                     static_cast<unsigned>(s.front_face) > static_cast<unsigned>(FrontFace::CW))
                     return Error{cmd_name(i) + ": invalid cull/front face"};
+                if (s.mode == RasterMode::ExactBounds && s.cull_face != CullFace::None)
+                    return Error{cmd_name(i) + ": RasterMode::ExactBounds needs CullFace::None (an edge-on triangle "
+                                               "has no facing, and a conservative mode may not drop it)"};
                 if (s.viewport) {
                     const Viewport& v = *s.viewport;
                     if (v.width < 1 || v.height < 1 || v.width > kMaxTargetSize || v.height > kMaxTargetSize ||
@@ -83,19 +108,32 @@ Status validate(const DepthTarget& target, const CommandBatch& batch) {
                                      ", origin within +-" + std::to_string(kMaxTargetSize) + ")"};
                     }
                 }
-                const auto& idx = c.mesh.indices;
-                const auto& vtx = c.mesh.vertices;
+                const auto& idx = c.double_input ? c.mesh_d.indices : c.mesh.indices;
+                const std::size_t vertex_count = c.double_input ? c.mesh_d.vertices.size() : c.mesh.vertices.size();
                 if (idx.size() % 3 != 0) {
                     return Error{cmd_name(i) + ": index count " + std::to_string(idx.size()) + " is not a multiple of 3"};
                 }
                 // Only vertices that triangles use are checked (a shared vertex list may hold others).
                 for (std::size_t k = 0; k < idx.size(); ++k) {
-                    if (idx[k] >= vtx.size()) {
+                    if (idx[k] >= vertex_count) {
                         return Error{cmd_name(i) + ": index " + std::to_string(idx[k]) + " at position " +
                                      std::to_string(k) + " is beyond the vertex list (size " +
-                                     std::to_string(vtx.size()) + ")"};
+                                     std::to_string(vertex_count) + ")"};
                     }
-                    const Float4& v = vtx[idx[k]];
+                    if (s.mode == RasterMode::ExactBounds) {
+                        std::string why;
+                        if (c.double_input) {
+                            const Double4& d = c.mesh_d.vertices[idx[k]];
+                            why = check_exact_bounds_vertex(d.x, d.y, d.z, d.w);
+                        } else {
+                            const Float4& f = c.mesh.vertices[idx[k]];
+                            why = check_exact_bounds_vertex(static_cast<double>(f.x), static_cast<double>(f.y),
+                                                            static_cast<double>(f.z), static_cast<double>(f.w));
+                        }
+                        if (!why.empty()) return Error{cmd_name(i) + ": vertex " + std::to_string(idx[k]) + " " + why};
+                        continue;
+                    }
+                    const Float4& v = c.mesh.vertices[idx[k]];
                     if (!finite4(v)) return Error{cmd_name(i) + ": vertex " + std::to_string(idx[k]) + " is not finite"};
                     if (v.w == 0.0f && v.x == 0.0f && v.y == 0.0f && v.z == 0.0f) {
                         return Error{cmd_name(i) + ": vertex " + std::to_string(idx[k]) +

@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include "exact_bounds.h"
 #include "pipeline.h"
 #include "raster/command_batch.h"
 #include "validate.h"
@@ -29,6 +30,26 @@ detail::FrontEndParams params_for(const DepthTarget& target, const DrawState& s)
     p.cull_face = s.cull_face;
     p.front_face = s.front_face;
     return p;
+}
+
+Double4 widen(const Float4& v) {
+    return Double4{static_cast<double>(v.x), static_cast<double>(v.y), static_cast<double>(v.z), static_cast<double>(v.w)};
+}
+
+// Front end of one exact-bounds draw (float input is widened exactly).
+void setup_bounds_draw(const detail::FrontEndParams& p, const Command& c, std::uint32_t draw,
+                       std::vector<detail::BoundsTri>& out, std::vector<detail::BoundsVertex>& pool) {
+    const auto& idx = c.double_input ? c.mesh_d.indices : c.mesh.indices;
+    for (std::size_t k = 0; k + 2 < idx.size(); k += 3) {
+        if (c.double_input) {
+            const auto& v = c.mesh_d.vertices;
+            detail::setup_bounds_triangle(p, v[idx[k]], v[idx[k + 1]], v[idx[k + 2]], draw, out, pool);
+        } else {
+            const auto& v = c.mesh.vertices;
+            detail::setup_bounds_triangle(p, widen(v[idx[k]]), widen(v[idx[k + 1]]), widen(v[idx[k + 2]]), draw, out,
+                                          pool);
+        }
+    }
 }
 
 void finish_results(const CommandBatch& batch, QueryResults& r) {
@@ -63,6 +84,8 @@ Result<QueryResults> execute_reference(DepthTarget& target, const CommandBatch& 
     QueryResults results(batch.query_kinds().size(), 0);
     std::uint32_t active = kNoQuery;
     std::vector<detail::SetupTri> tris;
+    std::vector<detail::BoundsTri> btris;
+    std::vector<detail::BoundsVertex> bpool;
     std::uint32_t* depth = target.mutable_values().data();
     const auto& cmds = batch.commands();
     for (std::size_t i = 0; i < cmds.size(); ++i) {
@@ -76,6 +99,19 @@ Result<QueryResults> execute_reference(DepthTarget& target, const CommandBatch& 
             continue;
         }
         const detail::FrontEndParams p = params_for(target, c.state);
+        if (c.state.mode == RasterMode::ExactBounds) {
+            btris.clear();
+            bpool.clear();
+            setup_bounds_draw(p, c, static_cast<std::uint32_t>(i), btris, bpool);
+            for (const auto& t : btris) {
+                const std::uint64_t passed = detail::bounds_rect(t, bpool.data(), target.format(),
+                                                                 c.state.depth_func,
+                                                                 c.state.depth_write, depth, target.width(), t.x0,
+                                                                 t.y0, t.x1, t.y1);
+                if (active != kNoQuery) results[active] += passed;
+            }
+            continue;
+        }
         const auto& idx = c.mesh.indices;
         const auto& vtx = c.mesh.vertices;
         for (std::size_t k = 0; k + 2 < idx.size(); k += 3) {
@@ -116,9 +152,15 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
         }
     }
     std::vector<std::vector<detail::SetupTri>> per_draw(draw_cmds.size());
+    std::vector<std::vector<detail::BoundsTri>> per_draw_bounds(draw_cmds.size());  // exact-bounds draws
+    std::vector<std::vector<detail::BoundsVertex>> per_draw_pool(draw_cmds.size());
     run_parallel(threads, draw_cmds.size(), [&](std::size_t d) {
         const Command& c = cmds[draw_cmds[d]];
         const detail::FrontEndParams p = params_for(target, c.state);
+        if (c.state.mode == RasterMode::ExactBounds) {
+            setup_bounds_draw(p, c, draw_cmds[d], per_draw_bounds[d], per_draw_pool[d]);
+            return;
+        }
         const auto& idx = c.mesh.indices;
         const auto& vtx = c.mesh.vertices;
         auto& out = per_draw[d];
@@ -135,13 +177,20 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
         std::uint32_t tri;
     };
     std::vector<std::vector<Ref>> bins(tile_count);
+    auto bin = [&](std::size_t d, std::size_t t, int bx0, int by0, int bx1, int by1) {
+        for (int ty = by0 / kTileSize; ty <= by1 / kTileSize; ++ty)
+            for (int tx = bx0 / kTileSize; tx <= bx1 / kTileSize; ++tx)
+                bins[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x) + static_cast<std::size_t>(tx)]
+                    .push_back({static_cast<std::uint32_t>(d), static_cast<std::uint32_t>(t)});
+    };
     for (std::size_t d = 0; d < per_draw.size(); ++d) {
         for (std::size_t t = 0; t < per_draw[d].size(); ++t) {
             const auto& tri = per_draw[d][t];
-            for (int ty = tri.y0 / kTileSize; ty <= tri.y1 / kTileSize; ++ty)
-                for (int tx = tri.x0 / kTileSize; tx <= tri.x1 / kTileSize; ++tx)
-                    bins[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x) + static_cast<std::size_t>(tx)]
-                        .push_back({static_cast<std::uint32_t>(d), static_cast<std::uint32_t>(t)});
+            bin(d, t, tri.x0, tri.y0, tri.x1, tri.y1);
+        }
+        for (std::size_t t = 0; t < per_draw_bounds[d].size(); ++t) {
+            const auto& tri = per_draw_bounds[d][t];
+            bin(d, t, tri.x0, tri.y0, tri.x1, tri.y1);
         }
     }
 
@@ -158,13 +207,21 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
         const int x1 = std::min(x0 + kTileSize, width) - 1, y1 = std::min(y0 + kTileSize, height) - 1;
         auto& counts = tile_counts[tile];
         for (const Ref& r : bins[tile]) {
-            const auto& tri = per_draw[r.draw][r.tri];
-            const Command& c = cmds[tri.draw];
-            const std::uint64_t passed =
-                detail::raster_rect(tri, format, c.state.depth_func, c.state.depth_write, depth, width,
-                                    std::max(x0, tri.x0), std::max(y0, tri.y0), std::min(x1, tri.x1),
-                                    std::min(y1, tri.y1), options.allow_simd);
-            const std::uint32_t q = cmd_query[tri.draw];
+            const std::uint32_t cmd = draw_cmds[r.draw];
+            const Command& c = cmds[cmd];
+            std::uint64_t passed;
+            if (c.state.mode == RasterMode::ExactBounds) {
+                const auto& tri = per_draw_bounds[r.draw][r.tri];
+                passed = detail::bounds_rect(tri, per_draw_pool[r.draw].data(), format, c.state.depth_func,
+                                             c.state.depth_write, depth, width, std::max(x0, tri.x0),
+                                             std::max(y0, tri.y0), std::min(x1, tri.x1), std::min(y1, tri.y1));
+            } else {
+                const auto& tri = per_draw[r.draw][r.tri];
+                passed = detail::raster_rect(tri, format, c.state.depth_func, c.state.depth_write, depth, width,
+                                             std::max(x0, tri.x0), std::max(y0, tri.y0), std::min(x1, tri.x1),
+                                             std::min(y1, tri.y1), options.allow_simd);
+            }
+            const std::uint32_t q = cmd_query[cmd];
             if (q == kNoQuery || passed == 0) continue;
             if (!counts.empty() && counts.back().first == q) counts.back().second += passed;
             else counts.emplace_back(q, passed);

@@ -73,4 +73,95 @@ Result<std::vector<Float4>> transform_to_clip(const Mat4& m, std::span<const Dou
     return out;
 }
 
+namespace {
+
+double& axis_ref(Double3& p, int k) { return k == 0 ? p.x : (k == 1 ? p.y : p.z); }
+double axis_of(const Double3& p, int k) { return k == 0 ? p.x : (k == 1 ? p.y : p.z); }
+
+// The world axis index that becomes screen u, v and depth d (a cyclic permutation of x, y, z).
+void view_axis_indices(Axis axis, int& u, int& v, int& d) {
+    d = axis == Axis::X ? 0 : (axis == Axis::Y ? 1 : 2);
+    u = (d + 1) % 3;
+    v = (d + 2) % 3;
+}
+
+}  // namespace
+
+Result<OrthoView> make_ortho_view(Axis axis, Double3 box_min, Double3 box_max, int width, int height,
+                                  DepthFormat format) {
+    if (axis != Axis::X && axis != Axis::Y && axis != Axis::Z)
+        return Error{"ortho view: axis " + std::to_string(static_cast<int>(axis)) + " is not X, Y or Z"};
+    static const char* kNames[3] = {"x", "y", "z"};
+    for (int k = 0; k < 3; ++k) {
+        const double lo = axis_of(box_min, k), hi = axis_of(box_max, k);
+        if (!std::isfinite(lo) || !std::isfinite(hi))
+            return Error{std::string("ortho view: box bound along ") + kNames[k] + " is not finite"};
+        if (!(lo < hi))
+            return Error{std::string("ortho view: box is empty along ") + kNames[k] + " (min " + std::to_string(lo) +
+                         " >= max " + std::to_string(hi) + ")"};
+        const double scale = 2.0 / (hi - lo);
+        if (!std::isfinite(hi - lo) || !std::isfinite(scale) || scale == 0.0)
+            return Error{std::string("ortho view: box extent along ") + kNames[k] + " is outside the double range"};
+    }
+    if (width < 1 || height < 1 || width > kMaxTargetSize || height > kMaxTargetSize)
+        return Error{"ortho view: resolution " + std::to_string(width) + "x" + std::to_string(height) +
+                     " is outside 1.." + std::to_string(kMaxTargetSize) + " per side"};
+    if (format != DepthFormat::D16 && format != DepthFormat::D24 && format != DepthFormat::D32F)
+        return Error{"ortho view: depth format " + std::to_string(static_cast<int>(format)) + " is not D16, D24 or D32F"};
+    OrthoView v;
+    v.axis = axis;
+    v.box_min = box_min;
+    v.box_max = box_max;
+    v.width = width;
+    v.height = height;
+    v.format = format;
+    return v;
+}
+
+Double3 view_axes(const OrthoView& view, Double3 world) {
+    int u = 0, v = 0, d = 0;
+    view_axis_indices(view.axis, u, v, d);
+    return Double3{axis_of(world, u), axis_of(world, v), axis_of(world, d)};
+}
+
+Result<std::vector<Double4>> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points) {
+    const Double3 lo = view_axes(view, view.box_min);
+    const Double3 hi = view_axes(view, view.box_max);
+    Double3 scale;
+    for (int k = 0; k < 3; ++k) axis_ref(scale, k) = 2.0 / (axis_of(hi, k) - axis_of(lo, k));
+    std::vector<Double4> out;
+    out.reserve(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const Double3& p = points[i];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+            return Error{"ortho_view_to_clip: point " + std::to_string(i) + " is not finite"};
+        const Double3 a = view_axes(view, p);
+        Double4 c;
+        c.x = (a.x - lo.x) * scale.x - 1.0;
+        c.y = (a.y - lo.y) * scale.y - 1.0;
+        c.z = (a.z - lo.z) * scale.z - 1.0;
+        c.w = 1.0;
+        if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z))
+            return Error{"ortho_view_to_clip: point " + std::to_string(i) + " overflows the double range in clip space"};
+        out.push_back(c);
+    }
+    return out;
+}
+
+ViewCell view_cell(const OrthoView& view) {
+    const Double3 lo = view_axes(view, view.box_min);
+    const Double3 hi = view_axes(view, view.box_max);
+    double quantum = 0.0;
+    switch (view.format) {
+        case DepthFormat::D16: quantum = 1.0 / 65535.0; break;
+        case DepthFormat::D24: quantum = 1.0 / 16777215.0; break;
+        case DepthFormat::D32F: quantum = 1.0 / 16777216.0; break;
+    }
+    ViewCell c;
+    c.dx = (hi.x - lo.x) / static_cast<double>(view.width);
+    c.dy = (hi.y - lo.y) / static_cast<double>(view.height);
+    c.dz = (hi.z - lo.z) * quantum;
+    return c;
+}
+
 }  // namespace raster

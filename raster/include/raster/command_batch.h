@@ -11,12 +11,15 @@
 
 namespace raster {
 
-// One recorded command. Draw: mesh + state. BeginQuery/EndQuery: the query with index `query`.
+// One recorded command. Draw: mesh (float input) or mesh_d (double input, when double_input) +
+// state. BeginQuery/EndQuery: the query with index `query`.
 struct Command {
     enum class Kind : std::uint8_t { Draw, BeginQuery, EndQuery };
     Kind kind = Kind::Draw;
     std::uint32_t query = 0;
     MeshView mesh;
+    MeshViewD mesh_d;
+    bool double_input = false;
     DrawState state;
 };
 
@@ -27,6 +30,12 @@ class CommandBatch {
     CommandBatch(int target_width, int target_height) : width_(target_width), height_(target_height) {}
 
     void draw(MeshView mesh, const DrawState& state);
+    // Double-precision input for RasterMode::ExactBounds (docs/reliable-raster.md). execute() fails,
+    // naming the command, unless state.mode is ExactBounds and every used vertex is finite with
+    // w == 1 and |x|, |y|, |z| <= kMaxExactBoundsCoordinate, and state.cull_face is None (an
+    // edge-on triangle has no facing). Float input (draw(MeshView, ...)) is accepted in ExactBounds
+    // too, under the same rules (floats convert to double exactly).
+    void draw(MeshViewD mesh, const DrawState& state);
     // glBeginQuery; returns the query's index into the results of execute().
     std::uint32_t begin_query(QueryKind kind);
     void end_query();                         // glEndQuery of the active query

@@ -39,13 +39,15 @@
 //  - Determinism: same input, same bits, for the scalar reference and the tiled path with any
 //    thread count. Depth is computed from the plane at each pixel, never accumulated.
 //
-// Room left for a second raster mode ("exact bounds", conservative: every pixel a triangle touches,
-// with [zmin, zmax] over the pixel; writes use zmin, queries zmax), selected per draw through
-// DrawState::mode. Only RasterMode::GLExact exists today.
+// A second raster mode, RasterMode::ExactBounds (conservative: every pixel whose closed square the
+// closed triangle meets, with [zmin, zmax] over the pixel, rounded outward; writes use zmin, queries
+// zmax), is selected per draw through DrawState::mode: docs/reliable-raster.md. The paper's offset
+// construction for the GL-exact mode is in raster/offset_geometry.h.
 #pragma once
 
 #include "raster/command_batch.h"
 #include "raster/depth_target.h"
+#include "raster/offset_geometry.h"
 #include "raster/result.h"
 #include "raster/transform.h"
 #include "raster/types.h"

@@ -11,6 +11,10 @@ namespace raster {
 // Per side, in pixels. Keeps 16.8 fixed-point products inside 64 bits (see raster.h).
 inline constexpr int kMaxTargetSize = 16384;
 
+// Largest |x|, |y|, |z| the exact-bounds mode accepts in clip space (2^100: far beyond any view,
+// small enough that no product in its clipping can overflow a double).
+inline constexpr double kMaxExactBoundsCoordinate = 1267650600228229401496703205376.0;
+
 enum class DepthFormat : std::uint8_t { D16, D24, D32F };
 
 // GL depth functions (glDepthFunc), compared as incoming <op> stored.
@@ -19,9 +23,14 @@ enum class DepthFunc : std::uint8_t { Never, Less, Equal, LEqual, Greater, NotEq
 enum class CullFace : std::uint8_t { None, Front, Back };   // glCullFace (None = GL_CULL_FACE off)
 enum class FrontFace : std::uint8_t { CCW, CW };           // glFrontFace
 
-// How coverage and depth are decided. GLExact: pixel-centre sampling exactly as llvmpipe.
-// (Reserved: a conservative "exact bounds" mode with per-pixel depth ranges.)
-enum class RasterMode : std::uint8_t { GLExact };
+// How coverage and depth are decided (docs/raster.md, docs/reliable-raster.md).
+//  GLExact:     pixel-centre sampling exactly as llvmpipe (float input, bit-identical to OSMesa).
+//  ExactBounds: conservative (R-CULLIDE's reliable rasterization, done in the emulator): every pixel
+//               whose closed square meets the closed triangle is covered, with a depth interval
+//               [zmin, zmax] bounding the triangle over that square, quantized outward. A draw with
+//               depth_write tests and writes zmin; a draw without tests zmax. Orthographic (w = 1)
+//               input only; double input through CommandBatch::draw(MeshViewD, ...).
+enum class RasterMode : std::uint8_t { GLExact, ExactBounds };
 
 enum class QueryKind : std::uint8_t { SamplesPassed, AnySamplesPassed };
 
@@ -45,6 +54,20 @@ struct Float4 {
 // spans must stay valid until the batch that holds the view has been executed.
 struct MeshView {
     std::span<const Float4> vertices;
+    std::span<const std::uint32_t> indices;
+};
+
+// A clip-space vertex in double precision, for the exact-bounds mode (w must be 1).
+struct Double4 {
+    double x = 0;
+    double y = 0;
+    double z = 0;
+    double w = 1;
+};
+
+// MeshView with double vertices (clip space, orthographic: w = 1). Same lifetime rule as MeshView.
+struct MeshViewD {
+    std::span<const Double4> vertices;
     std::span<const std::uint32_t> indices;
 };
 

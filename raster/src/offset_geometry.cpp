@@ -1,0 +1,279 @@
+// offset_geometry.cpp: R-CULLIDE's offset boxes (Govindaraju, Lin, Manocha 2004/2006) as triangles.
+// See raster/offset_geometry.h.
+#include "raster/offset_geometry.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+
+namespace raster {
+namespace {
+
+// Corner k = bit 0: +axis 0, bit 1: +axis 1, bit 2: +axis 2. Wound with inward right-hand normals in
+// a right-handed (axis 0, axis 1, axis 2) frame: the view map keeps orientation and looks along +d,
+// so the faces towards the viewer come out counter-clockwise in the window (front with CCW).
+constexpr std::uint32_t kBox[36] = {0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1,
+                                    2, 3, 7, 2, 7, 6, 0, 2, 6, 0, 6, 4, 1, 5, 7, 1, 7, 3};
+
+double comp(const Double3& p, int k) { return k == 0 ? p.x : (k == 1 ? p.y : p.z); }
+
+float round_down(double v) {
+    float f = static_cast<float>(v);
+    if (static_cast<double>(f) > v) f = std::nextafter(f, -HUGE_VALF);
+    return f;
+}
+float round_up(double v) {
+    float f = static_cast<float>(v);
+    if (static_cast<double>(f) < v) f = std::nextafter(f, HUGE_VALF);
+    return f;
+}
+
+// GL clips at the near and far planes (no depth clamp), and a box grown by r often reaches past
+// both: its near and far faces would vanish. Clamping an axis-aligned box's clip z to [-1, 1] keeps
+// it conservative: the near face moves to depth 0 (written: <= every true depth) and the far face to
+// depth 1 (queried: >= every true depth), and nothing outside [0, 1] is visible in the first place.
+// x and y are clamped to [-2, 2] for precision, not visibility: GL's float clipper interpolates
+// with errors relative to the coordinates, and a box reaching 1e8 would be clipped by whole pixels
+// (a fuzzer finding); the part beyond +-1 is never drawn, so the clamped box covers the same pixels.
+constexpr float kXYClamp = 2.0f;
+void clamp_box(float* cmin, float* cmax) {
+    const float lim[3] = {kXYClamp, kXYClamp, 1.0f};
+    for (int k = 0; k < 3; ++k) {
+        if (cmin[k] < -lim[k] && cmax[k] >= -lim[k]) cmin[k] = -lim[k];
+        if (cmax[k] > lim[k] && cmin[k] <= lim[k]) cmax[k] = lim[k];
+    }
+}
+
+struct Frame {
+    Double3 lo;
+    Double3 scale;  // clip = (a - lo) * scale - 1 per view axis
+};
+Frame frame_of(const OrthoView& view) {
+    Frame f;
+    f.lo = view_axes(view, view.box_min);
+    const Double3 hi = view_axes(view, view.box_max);
+    f.scale = {2.0 / (hi.x - f.lo.x), 2.0 / (hi.y - f.lo.y), 2.0 / (hi.z - f.lo.z)};
+    return f;
+}
+
+Status validate_mesh(std::span<const Double3> vertices, std::span<const std::uint32_t> indices,
+                     const char* what) {
+    if (indices.size() % 3 != 0)
+        return Error{std::string(what) + ": index count " + std::to_string(indices.size()) +
+                     " is not a multiple of 3"};
+    for (std::size_t k = 0; k < indices.size(); ++k) {
+        if (indices[k] >= vertices.size())
+            return Error{std::string(what) + ": triangle " + std::to_string(k / 3) + ": index " +
+                         std::to_string(indices[k]) + " at position " + std::to_string(k) +
+                         " is beyond the vertex list (size " + std::to_string(vertices.size()) + ")"};
+        const Double3& p = vertices[indices[k]];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+            return Error{std::string(what) + ": triangle " + std::to_string(k / 3) + ": vertex " +
+                         std::to_string(indices[k]) + " is not finite"};
+    }
+    return {};
+}
+
+void append_box(OffsetMesh& out, const std::array<Float4, 8>& corners) {
+    const auto base = static_cast<std::uint32_t>(out.vertices.size());
+    for (const Float4& c : corners) out.vertices.push_back(c);
+    for (std::uint32_t i : kBox) out.indices.push_back(base + i);
+}
+
+Double3 sub(const Double3& a, const Double3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+Double3 cross(const Double3& a, const Double3& b) {
+    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+double dot(const Double3& a, const Double3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+Double3 normalized(const Double3& a) {
+    const double n = std::sqrt(dot(a, a));
+    return {a.x / n, a.y / n, a.z / n};
+}
+
+}  // namespace
+
+double offset_radius(const OrthoView& view) {
+    const ViewCell c = view_cell(view);
+    const double p = std::max({2.0 * c.dx, 2.0 * c.dy, 2.0 * c.dz});
+    // sqrt(3) / 2 rounded up, then one ulp up for the product's rounding.
+    const double r = p * 0.86602540378443872;
+    return std::nextafter(r, HUGE_VAL);
+}
+
+Result<OffsetMesh> triangle_offset_boxes(const OrthoView& view, std::span<const Double3> vertices,
+                                         std::span<const std::uint32_t> indices) {
+    if (Status s = validate_mesh(vertices, indices, "triangle_offset_boxes"); !s) return s.error();
+    const Frame f = frame_of(view);
+    const double r = offset_radius(view);
+    OffsetMesh out;
+    out.vertices.reserve(indices.size() / 3 * 8);
+    out.indices.reserve(indices.size() / 3 * 36);
+    for (std::size_t t = 0; t + 2 < indices.size(); t += 3) {
+        Double3 lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+        for (int k = 0; k < 3; ++k) {
+            const Double3 a = view_axes(view, vertices[indices[t + static_cast<std::size_t>(k)]]);
+            lo = {std::min(lo.x, a.x), std::min(lo.y, a.y), std::min(lo.z, a.z)};
+            hi = {std::max(hi.x, a.x), std::max(hi.y, a.y), std::max(hi.z, a.z)};
+        }
+        // Clip bounds in double, then pushed out by more than their rounding error (each of the
+        // three operations errs by <= 1/2 ulp; 2^-50 |c| + 2^-52 covers all three), then rounded
+        // outward to float.
+        float cmin[3], cmax[3];
+        for (int k = 0; k < 3; ++k) {
+            const double l = (comp(lo, k) - r - comp(f.lo, k)) * comp(f.scale, k) - 1.0;
+            const double h = (comp(hi, k) + r - comp(f.lo, k)) * comp(f.scale, k) - 1.0;
+            cmin[k] = round_down(l - (std::fabs(l) * 0x1p-50 + 0x1p-52));
+            cmax[k] = round_up(h + (std::fabs(h) * 0x1p-50 + 0x1p-52));
+            if (!std::isfinite(cmin[k]) || !std::isfinite(cmax[k]))
+                return Error{"triangle_offset_boxes: triangle " + std::to_string(t / 3) +
+                             ": its box overflows float in clip space"};
+        }
+        clamp_box(cmin, cmax);
+        std::array<Float4, 8> corners{};
+        for (int c = 0; c < 8; ++c)
+            corners[static_cast<std::size_t>(c)] = {(c & 1) ? cmax[0] : cmin[0], (c & 2) ? cmax[1] : cmin[1],
+                                                    (c & 4) ? cmax[2] : cmin[2], 1.0f};
+        append_box(out, corners);
+    }
+    return out;
+}
+
+Result<OffsetMesh> object_offset_obbs(const OrthoView& view, std::span<const Double3> vertices,
+                                      std::span<const std::uint32_t> indices,
+                                      std::uint32_t triangles_per_box) {
+    if (Status s = validate_mesh(vertices, indices, "object_offset_obbs"); !s) return s.error();
+    if (triangles_per_box < 1) return Error{"object_offset_obbs: triangles_per_box must be >= 1"};
+    const Frame f = frame_of(view);
+    const double r = offset_radius(view);
+    const std::size_t tris = indices.size() / 3;
+    OffsetMesh out;
+    for (std::size_t g0 = 0; g0 < tris; g0 += triangles_per_box) {
+        const std::size_t g1 = std::min(tris, g0 + triangles_per_box);
+        // Frame candidates, in view coordinates (u, v, d), each right-handed and Gram-Schmidt
+        // orthonormalized (a0, a1, a2 = a0 x a1): the view axes, and for the group's largest
+        // triangle its normal with each of its three edges. The candidate whose box (grown by r)
+        // has the least volume wins (the first on ties), so a box-shaped group gets its own box.
+        std::size_t largest = g1;
+        double best_area = 0.0;
+        for (std::size_t t = g0; t < g1; ++t) {
+            const Double3 p0 = view_axes(view, vertices[indices[3 * t]]);
+            const Double3 n = cross(sub(view_axes(view, vertices[indices[3 * t + 1]]), p0),
+                                    sub(view_axes(view, vertices[indices[3 * t + 2]]), p0));
+            const double area2 = dot(n, n);
+            if (area2 > best_area && std::isfinite(area2)) {
+                best_area = area2;
+                largest = t;
+            }
+        }
+        std::array<std::array<Double3, 3>, 4> cand{};
+        int ncand = 0;
+        cand[static_cast<std::size_t>(ncand++)] = {Double3{1, 0, 0}, Double3{0, 1, 0}, Double3{0, 0, 1}};
+        if (largest < g1) {
+            const Double3 p[3] = {view_axes(view, vertices[indices[3 * largest]]),
+                                  view_axes(view, vertices[indices[3 * largest + 1]]),
+                                  view_axes(view, vertices[indices[3 * largest + 2]])};
+            const Double3 b2 = normalized(cross(sub(p[1], p[0]), sub(p[2], p[0])));
+            for (int k = 0; k < 3; ++k) {
+                const Double3 b0 = normalized(sub(p[(k + 1) % 3], p[k]));
+                const Double3 b1 = normalized(cross(b2, b0));
+                const Double3 c2 = cross(b0, b1);
+                if (!std::isfinite(b0.x + b0.y + b0.z + b1.x + b1.y + b1.z + c2.x + c2.y + c2.z)) continue;
+                cand[static_cast<std::size_t>(ncand++)] = {b0, b1, c2};
+            }
+        }
+        Double3 a0{1, 0, 0}, a1{0, 1, 0}, a2{0, 0, 1};
+        double best_volume = HUGE_VAL;
+        for (int ci = 0; ci < ncand; ++ci) {
+            const auto& ax = cand[static_cast<std::size_t>(ci)];
+            double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+            for (std::size_t k = 3 * g0; k < 3 * g1; ++k) {
+                const Double3 q = view_axes(view, vertices[indices[k]]);
+                for (std::size_t a = 0; a < 3; ++a) {
+                    const double d = dot(q, ax[a]);
+                    lo[a] = std::min(lo[a], d);
+                    hi[a] = std::max(hi[a], d);
+                }
+            }
+            const double volume = (hi[0] - lo[0] + 2 * r) * (hi[1] - lo[1] + 2 * r) * (hi[2] - lo[2] + 2 * r);
+            if (volume < best_volume) {
+                best_volume = volume;
+                a0 = ax[0];
+                a1 = ax[1];
+                a2 = ax[2];
+            }
+        }
+        const Double3 axes[3] = {a0, a1, a2};
+        // Extents along the frame, exact radius r added; then grown by g, which covers the frame's
+        // departure from orthonormality (<= 2^-40 relative) and the float rounding of the corners.
+        double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+        double radius = 0.0;
+        for (std::size_t k = 3 * g0; k < 3 * g1; ++k) {
+            const Double3 p = view_axes(view, vertices[indices[k]]);
+            for (int a = 0; a < 3; ++a) {
+                const double d = dot(p, axes[a]);
+                lo[a] = std::min(lo[a], d);
+                hi[a] = std::max(hi[a], d);
+            }
+            radius = std::max({radius, std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+        }
+        auto corners_for = [&](double grow, double& cmax) {
+            std::array<Double4, 8> c{};
+            cmax = 1.0;
+            for (int k = 0; k < 8; ++k) {
+                Double3 p{0, 0, 0};
+                for (int a = 0; a < 3; ++a) {
+                    const double t = (k & (1 << a)) ? hi[a] + r + grow : lo[a] - r - grow;
+                    p = {p.x + t * axes[a].x, p.y + t * axes[a].y, p.z + t * axes[a].z};
+                }
+                Double4& q = c[static_cast<std::size_t>(k)];
+                q.x = (p.x - f.lo.x) * f.scale.x - 1.0;
+                q.y = (p.y - f.lo.y) * f.scale.y - 1.0;
+                q.z = (p.z - f.lo.z) * f.scale.z - 1.0;
+                cmax = std::max({cmax, std::fabs(q.x), std::fabs(q.y), std::fabs(q.z)});
+            }
+            return c;
+        };
+        double cmax = 1.0;
+        (void)corners_for(0.0, cmax);
+        const double inv_scale = std::max({1.0 / f.scale.x, 1.0 / f.scale.y, 1.0 / f.scale.z});
+        const double grow =
+            8.0 * cmax * 0x1p-24 * inv_scale +
+            0x1p-40 * (radius + r + std::fabs(f.lo.x) + std::fabs(f.lo.y) + std::fabs(f.lo.z));
+        const std::array<Double4, 8> c = corners_for(grow, cmax);
+        std::array<Float4, 8> corners{};
+        bool beyond_depth = false;
+        for (const Double4& q : c)
+            beyond_depth =
+                beyond_depth || q.z < -1.0 || q.z > 1.0 || std::fabs(q.x) > 2.0 || std::fabs(q.y) > 2.0;
+        if (beyond_depth) {
+            // An oriented box cannot be clamped and stay a box: use its axis-aligned bounding box
+            // instead (it contains the oriented one), clamped as above.
+            float bmin[3] = {HUGE_VALF, HUGE_VALF, HUGE_VALF}, bmax[3] = {-HUGE_VALF, -HUGE_VALF, -HUGE_VALF};
+            for (const Double4& q : c) {
+                const double v[3] = {q.x, q.y, q.z};
+                for (int k = 0; k < 3; ++k) {
+                    bmin[k] = std::min(bmin[k], round_down(v[k]));
+                    bmax[k] = std::max(bmax[k], round_up(v[k]));
+                }
+            }
+            clamp_box(bmin, bmax);
+            for (int k = 0; k < 8; ++k)
+                corners[static_cast<std::size_t>(k)] = {(k & 1) ? bmax[0] : bmin[0],
+                                                        (k & 2) ? bmax[1] : bmin[1],
+                                                        (k & 4) ? bmax[2] : bmin[2], 1.0f};
+        }
+        for (std::size_t k = 0; k < 8; ++k) {
+            if (!beyond_depth)
+                corners[k] = {static_cast<float>(c[k].x), static_cast<float>(c[k].y),
+                              static_cast<float>(c[k].z), 1.0f};
+            if (!std::isfinite(corners[k].x) || !std::isfinite(corners[k].y) || !std::isfinite(corners[k].z))
+                return Error{"object_offset_obbs: box of triangles " + std::to_string(g0) + ".." +
+                             std::to_string(g1 - 1) + " overflows float in clip space"};
+        }
+        append_box(out, corners);
+    }
+    return out;
+}
+
+}  // namespace raster

@@ -1,0 +1,261 @@
+// offset_geometry_test.cpp: R-CULLIDE's offset boxes (raster/offset_geometry.h) and the orthographic
+// view helper (raster/transform.h), each against an exact rational check: the boxes contain the
+// triangles grown by r (balls of radius r around every vertex, exactly), their winding makes
+// CullFace::Back draw the near faces and CullFace::Front the far ones, and ortho_view_to_clip stays
+// within its documented error.
+#include <doctest/doctest.h>
+#include <gmpxx.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "raster/raster.h"
+#include "test_rng.h"
+
+namespace {
+
+using raster::Double3;
+
+double comp(const Double3& p, int k) { return k == 0 ? p.x : (k == 1 ? p.y : p.z); }
+
+// The view map of transform.h in exact arithmetic: clip = 2 (a - lo) / (hi - lo) - 1 per view axis.
+struct ExactView {
+    mpq_class lo[3], hi[3];
+    explicit ExactView(const raster::OrthoView& v) {
+        const Double3 l = raster::view_axes(v, v.box_min), h = raster::view_axes(v, v.box_max);
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = comp(l, k);
+            hi[k] = comp(h, k);
+        }
+    }
+    // view coordinates (u, v, d) of a clip value along axis k
+    mpq_class from_clip(int k, double c) const { return (mpq_class(c) + 1) * (hi[k] - lo[k]) / 2 + lo[k]; }
+    mpq_class to_clip(int k, const mpq_class& a) const { return 2 * (a - lo[k]) / (hi[k] - lo[k]) - 1; }
+};
+
+raster::OrthoView random_view(test::Rng& rng, raster::Axis axis, raster::DepthFormat f) {
+    const double s = std::ldexp(1.0, static_cast<int>(rng.below(30)) - 10);
+    const Double3 lo{rng.uniform(-5, 5) * s, rng.uniform(-5, 5) * s, rng.uniform(-5, 5) * s};
+    const Double3 hi{lo.x + rng.uniform(0.5, 8) * s, lo.y + rng.uniform(0.5, 8) * s,
+                     lo.z + rng.uniform(0.5, 8) * s};
+    auto v = raster::make_ortho_view(axis, lo, hi, 16 + static_cast<int>(rng.below(300)),
+                                     16 + static_cast<int>(rng.below(300)), f);
+    REQUIRE(v.ok());
+    return v.value();
+}
+
+std::vector<Double3> random_points(test::Rng& rng, const raster::OrthoView& v, int n) {
+    std::vector<Double3> p;
+    for (int i = 0; i < n; ++i)
+        p.push_back({rng.uniform(v.box_min.x, v.box_max.x), rng.uniform(v.box_min.y, v.box_max.y),
+                     rng.uniform(v.box_min.z, v.box_max.z)});
+    return p;
+}
+
+// r^2 >= 3/4 p^2 exactly, with p = max(2 dx, 2 dy, 2 dz) of the view in exact arithmetic.
+bool radius_is_enough(const raster::OrthoView& v, double r) {
+    const ExactView e(v);
+    const mpq_class quantum = v.format == raster::DepthFormat::D16   ? mpq_class(1, 65535)
+                              : v.format == raster::DepthFormat::D24 ? mpq_class(1, 16777215)
+                                                                     : mpq_class(1, 16777216);
+    mpq_class p = 2 * (e.hi[0] - e.lo[0]) / v.width;
+    p = std::max(p, mpq_class(2 * (e.hi[1] - e.lo[1]) / v.height));
+    p = std::max(p, mpq_class(2 * (e.hi[2] - e.lo[2]) * quantum));
+    const mpq_class rq(r);
+    return rq * rq * 4 >= 3 * p * p;
+}
+
+// Every ball of radius r around a vertex lies inside the box (its 12 triangle planes, exactly),
+// in view coordinates; the box's corners are read back from the floats exactly.
+bool box_contains_balls(const raster::OrthoView& v, const raster::OffsetMesh& m, std::size_t box,
+                        const std::vector<Double3>& pts, double r) {
+    const ExactView e(v);
+    std::vector<std::array<mpq_class, 3>> c(8);
+    for (std::size_t k = 0; k < 8; ++k) {
+        const raster::Float4& f = m.vertices[8 * box + k];
+        const double cc[3] = {static_cast<double>(f.x), static_cast<double>(f.y), static_cast<double>(f.z)};
+        for (int a = 0; a < 3; ++a) c[k][static_cast<std::size_t>(a)] = e.from_clip(a, cc[a]);
+    }
+    const mpq_class rr = mpq_class(r) * mpq_class(r);
+    for (std::size_t t = 0; t < 12; ++t) {
+        const auto& a = c[m.indices[36 * box + 3 * t] - 8 * box];
+        const auto& b = c[m.indices[36 * box + 3 * t + 1] - 8 * box];
+        const auto& d = c[m.indices[36 * box + 3 * t + 2] - 8 * box];
+        mpq_class u[3], w[3], n[3];
+        for (int k = 0; k < 3; ++k) {
+            u[k] = b[static_cast<std::size_t>(k)] - a[static_cast<std::size_t>(k)];
+            w[k] = d[static_cast<std::size_t>(k)] - a[static_cast<std::size_t>(k)];
+        }
+        n[0] = u[1] * w[2] - u[2] * w[1];
+        n[1] = u[2] * w[0] - u[0] * w[2];
+        n[2] = u[0] * w[1] - u[1] * w[0];
+        const mpq_class nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+        if (nn == 0) continue;  // a flat (zero-thickness) face triangle bounds nothing
+        for (const Double3& p : pts) {
+            const Double3 q = raster::view_axes(v, p);
+            mpq_class s = 0;
+            for (int k = 0; k < 3; ++k) s += n[k] * (mpq_class(comp(q, k)) - a[static_cast<std::size_t>(k)]);
+            // Inward normals (kBox winding): inside means s >= r |n|.
+            if (sgn(s) < 0 || s * s < rr * nn) return false;
+        }
+    }
+    return true;
+}
+
+}  // namespace
+
+TEST_CASE("The orthographic view helper maps the box to [-1, 1] within its documented error") {
+    test::Rng rng(11);
+    for (int rep = 0; rep < 300; ++rep) {
+        const auto axis = static_cast<raster::Axis>(rep % 3);
+        const raster::OrthoView v = random_view(rng, axis, raster::DepthFormat::D24);
+        const ExactView e(v);
+        const auto pts = random_points(rng, v, 4);
+        auto c = raster::ortho_view_to_clip(v, pts);
+        REQUIRE(c.ok());
+        for (std::size_t i = 0; i < pts.size(); ++i) {
+            const Double3 a = raster::view_axes(v, pts[i]);
+            const double got[3] = {c.value()[i].x, c.value()[i].y, c.value()[i].z};
+            CHECK(c.value()[i].w == 1.0);
+            for (int k = 0; k < 3; ++k) {
+                const mpq_class exact = e.to_clip(k, mpq_class(comp(a, k)));
+                mpq_class err = mpq_class(got[k]) - exact;
+                if (sgn(err) < 0) err = -err;
+                // 3 ulp(max(1, |clip|)) + 2^-52 with |clip| <= 1 here: below 2^-49.
+                CHECK(err <= mpq_class(std::ldexp(1.0, -49)));
+            }
+        }
+    }
+    // Axis permutations are cyclic (orientation-preserving).
+    auto v = raster::make_ortho_view(raster::Axis::X, {0, 0, 0}, {1, 2, 3}, 8, 8, raster::DepthFormat::D16);
+    REQUIRE(v.ok());
+    const Double3 a = raster::view_axes(v.value(), {10, 20, 30});
+    CHECK(a.x == 20);
+    CHECK(a.y == 30);
+    CHECK(a.z == 10);
+}
+
+TEST_CASE("Offset boxes contain every triangle grown by the paper's radius, exactly") {
+    test::Rng rng(12);
+    for (int rep = 0; rep < 120; ++rep) {
+        CAPTURE(rep);
+        const auto f = static_cast<raster::DepthFormat>(rep % 3);
+        const raster::OrthoView v = random_view(rng, static_cast<raster::Axis>((rep / 3) % 3), f);
+        // Big depth extent vs pixels sometimes, so the boxes are not always clamped in depth.
+        const auto pts = random_points(rng, v, 9);
+        std::vector<std::uint32_t> idx = {0, 1, 2, 3, 4, 5, 6, 7, 8};
+        if (rep % 4 == 0) idx = {0, 0, 1, 2, 2, 2, 3, 4, 3};  // degenerate: segments and points
+        const double r = raster::offset_radius(v);
+        CHECK(radius_is_enough(v, r));
+        auto boxes = raster::triangle_offset_boxes(v, pts, idx);
+        REQUIRE(boxes.ok());
+        REQUIRE(boxes.value().vertices.size() == 24);
+        REQUIRE(boxes.value().indices.size() == 108);
+        for (std::size_t t = 0; t < 3; ++t) {
+            CAPTURE(t);
+            std::vector<Double3> tri = {pts[idx[3 * t]], pts[idx[3 * t + 1]], pts[idx[3 * t + 2]]};
+            // Depth is clamped to the view's range, so only check balls inside it along the depth axis.
+            const Double3 lo = raster::view_axes(v, v.box_min), hi = raster::view_axes(v, v.box_max);
+            bool inside = true;
+            for (const auto& p : tri) {
+                const double d = raster::view_axes(v, p).z;
+                inside = inside && d - r >= lo.z && d + r <= hi.z;
+            }
+            if (inside) CHECK(box_contains_balls(v, boxes.value(), t, tri, r));
+        }
+        auto obbs = raster::object_offset_obbs(v, pts, idx, 2);
+        REQUIRE(obbs.ok());
+        REQUIRE(obbs.value().vertices.size() == 16);
+        const std::vector<Double3> g0 = {pts[idx[0]], pts[idx[1]], pts[idx[2]],
+                                         pts[idx[3]], pts[idx[4]], pts[idx[5]]};
+        const std::vector<Double3> g1 = {pts[idx[6]], pts[idx[7]], pts[idx[8]]};
+        const Double3 lo = raster::view_axes(v, v.box_min), hi = raster::view_axes(v, v.box_max);
+        auto within = [&](const std::vector<Double3>& g) {
+            for (const auto& p : g) {
+                const double d = raster::view_axes(v, p).z;
+                if (d - 4 * r < lo.z || d + 4 * r > hi.z)
+                    return false;  // may have fallen back to a clamped box
+            }
+            return true;
+        };
+        if (within(g0)) CHECK(box_contains_balls(v, obbs.value(), 0, g0, r));
+        if (within(g1)) CHECK(box_contains_balls(v, obbs.value(), 1, g1, r));
+    }
+}
+
+TEST_CASE("Offset boxes: CullFace::Back draws the near faces and CullFace::Front the far faces") {
+    for (const auto axis : {raster::Axis::X, raster::Axis::Y, raster::Axis::Z}) {
+        CAPTURE(static_cast<int>(axis));
+        // Depth extent 1000 world units: r (about 1.7 pixels = 1.7 units) stays inside the range.
+        auto v = raster::make_ortho_view(axis, {0, 0, 0}, {1000, 1000, 1000}, 1000, 1000,
+                                         raster::DepthFormat::D24);
+        REQUIRE(v.ok());
+        const std::vector<Double3> tri = {{400, 400, 400}, {600, 450, 500}, {450, 600, 600}};
+        const std::vector<std::uint32_t> idx = {0, 1, 2};
+        for (int kind = 0; kind < 2; ++kind) {
+            auto m = kind == 0 ? raster::triangle_offset_boxes(v.value(), tri, idx)
+                               : raster::object_offset_obbs(v.value(), tri, idx, 1);
+            REQUIRE(m.ok());
+            double depth[2] = {};
+            for (int pass = 0; pass < 2; ++pass) {
+                auto t = raster::DepthTarget::create(1000, 1000, raster::DepthFormat::D24);
+                REQUIRE(t.ok());
+                raster::CommandBatch b(1000, 1000);
+                raster::DrawState s;
+                s.cull_face = pass == 0 ? raster::CullFace::Back : raster::CullFace::Front;
+                s.depth_func = raster::DepthFunc::Always;
+                b.draw(m.value().view(), s);
+                REQUIRE(raster::execute(t.value(), b).ok());
+                depth[pass] = t.value().depth(500, 500);
+            }
+            // The triangle's own depth at the pixel centre (500.5, 500.5), from its view-space plane.
+            Double3 q[3];
+            for (int k = 0; k < 3; ++k) q[k] = raster::view_axes(v.value(), tri[static_cast<std::size_t>(k)]);
+            const double px = 500.5, py = 500.5;
+            const double det = (q[1].x - q[0].x) * (q[2].y - q[0].y) - (q[2].x - q[0].x) * (q[1].y - q[0].y);
+            const double b1 = ((px - q[0].x) * (q[2].y - q[0].y) - (q[2].x - q[0].x) * (py - q[0].y)) / det;
+            const double b2 = ((q[1].x - q[0].x) * (py - q[0].y) - (px - q[0].x) * (q[1].y - q[0].y)) / det;
+            const double dtri = (q[0].z + b1 * (q[1].z - q[0].z) + b2 * (q[2].z - q[0].z)) / 1000.0;
+            CAPTURE(kind);
+            CAPTURE(dtri);
+            CHECK(depth[0] < dtri);
+            CHECK(depth[1] > dtri);
+            if (kind == 1) {  // an oriented box hugs the triangle's plane
+                CHECK(depth[0] > dtri - 0.02);
+                CHECK(depth[1] < dtri + 0.02);
+            } else {  // an axis-aligned one spans the triangle's depth range, 0.4 .. 0.6, grown by r
+                CHECK(depth[0] < 0.4);
+                CHECK(depth[1] > 0.6);
+            }
+        }
+    }
+}
+
+TEST_CASE("Offset geometry and view helpers reject bad input naming what is wrong") {
+    auto bad = raster::make_ortho_view(raster::Axis::Z, {0, 0, 1}, {1, 1, 1}, 8, 8, raster::DepthFormat::D24);
+    REQUIRE_FALSE(bad.ok());
+    CHECK(bad.error().message.find("empty along z") != std::string::npos);
+    bad = raster::make_ortho_view(raster::Axis::Z, {0, 0, 0}, {1, std::nan(""), 1}, 8, 8,
+                                  raster::DepthFormat::D24);
+    REQUIRE_FALSE(bad.ok());
+    CHECK(bad.error().message.find("not finite") != std::string::npos);
+    bad = raster::make_ortho_view(raster::Axis::Z, {0, 0, 0}, {1, 1, 1}, 0, 8, raster::DepthFormat::D24);
+    REQUIRE_FALSE(bad.ok());
+    auto v = raster::make_ortho_view(raster::Axis::Z, {0, 0, 0}, {1, 1, 1}, 8, 8, raster::DepthFormat::D24);
+    REQUIRE(v.ok());
+    const std::vector<Double3> pts = {{0, 0, 0}, {1, 0, 0}, {0, std::nan(""), 0}};
+    auto m = raster::triangle_offset_boxes(v.value(), pts, std::vector<std::uint32_t>{0, 1, 2});
+    REQUIRE_FALSE(m.ok());
+    CHECK(m.error().message.find("triangle 0: vertex 2 is not finite") != std::string::npos);
+    m = raster::object_offset_obbs(v.value(), pts, std::vector<std::uint32_t>{0, 1, 7});
+    REQUIRE_FALSE(m.ok());
+    CHECK(m.error().message.find("index 7 at position 2") != std::string::npos);
+    m = raster::triangle_offset_boxes(v.value(), pts, std::vector<std::uint32_t>{0, 1});
+    REQUIRE_FALSE(m.ok());
+    CHECK(m.error().message.find("multiple of 3") != std::string::npos);
+    auto c = raster::ortho_view_to_clip(v.value(), pts);
+    REQUIRE_FALSE(c.ok());
+    CHECK(c.error().message.find("point 2") != std::string::npos);
+}
