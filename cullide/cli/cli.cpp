@@ -32,10 +32,18 @@ constexpr const char* kUsage =
     "one object, or one object per OBJ group, in argument order.\n"
     "\n"
     "run options:\n"
-    "  --method M        collision method (default exact; see below)\n"
+    "  --method M        exact (default; the ground truth), cullide (GL-exact visibility culling, may\n"
+    "                    miss collisions like the GPU original), rcullide (R-CULLIDE, exact-bounds\n"
+    "                    conservative raster: never misses), rcullide-offset (R-CULLIDE with the\n"
+    "                    paper's offset solids: never misses)\n"
     "  --frames N        frames to run (default 10 for built-in scenes, 1 for files; 1..1000000)\n"
     "  --threads T       worker threads, 0 = all cores (default 0); results do not depend on it\n"
     "  --resolution R    view resolution of visibility methods, 16..16384 (default 1024)\n"
+    "  --depth-format F  depth buffer of visibility methods: d16, d24 (default), d32f\n"
+    "  --subobject N     triangles per sub-object of visibility methods, 1..65536 (default 4)\n"
+    "  --rounds N        rounds of x, y, z views per visibility stage, 1..1000 (default 4)\n"
+    "  --broadphase B    first stage on object boxes: none (default), spatialhash, sap, brute;\n"
+    "                    objects overlapping no other box are dropped at once\n"
     "  --self            also report pairs inside one object (adjacent triangles excluded)\n"
     "  --pairs FILE      write every colliding triangle pair as CSV:\n"
     "                    frame,object_a,triangle_a,object_b,triangle_b\n"
@@ -119,6 +127,24 @@ RunArgs parse_run_args(const std::vector<std::string>& args) {
                 throw UsageError{"--resolution must be an integer in 16..16384 (got '" + v + "')"};
             }
             r.options.resolution = *n;
+        } else if (a == "--depth-format") {
+            Result<raster::DepthFormat> f = parse_depth_format(need_value(i));
+            if (!f) throw UsageError{"--depth-format: " + f.error().message};
+            r.options.depth_format = f.value();
+        } else if (a == "--broadphase") {
+            Result<BroadPhase> b = parse_broadphase(need_value(i));
+            if (!b) throw UsageError{"--broadphase: " + b.error().message};
+            r.options.broadphase = b.value();
+        } else if (a == "--subobject") {
+            const std::string& v = need_value(i);
+            auto n = parse_integer<int>(v);
+            if (!n || *n < 1 || *n > 65536) throw UsageError{"--subobject must be an integer in 1..65536 (got '" + v + "')"};
+            r.options.subobject_triangles = *n;
+        } else if (a == "--rounds") {
+            const std::string& v = need_value(i);
+            auto n = parse_integer<int>(v);
+            if (!n || *n < 1 || *n > 1000) throw UsageError{"--rounds must be an integer in 1..1000 (got '" + v + "')"};
+            r.options.max_rounds = *n;
         } else if (a == "--self") {
             r.options.self = true;
         } else if (a == "--pairs") {
@@ -193,13 +219,22 @@ int run_command(const std::vector<std::string>& args, std::ostream& out, std::os
         pairs_out << "frame,object_a,triangle_a,object_b,triangle_b\n";
     }
 
+    const bool visibility = r.options.method != Method::Exact;
     if (r.json) {
         out << "{\"scene\": \"" << json_escape(scene_label) << "\", \"method\": \"" << to_string(r.options.method)
-            << "\", \"self\": " << (r.options.self ? "true" : "false") << ", \"frames\": [";
+            << "\", \"self\": " << (r.options.self ? "true" : "false") << ", \"resolution\": "
+            << r.options.resolution << ", \"depth_format\": \"" << to_string(r.options.depth_format)
+            << "\", \"subobject\": " << r.options.subobject_triangles << ", \"rounds\": " << r.options.max_rounds
+            << ", \"broadphase\": \"" << to_string(r.options.broadphase) << "\", \"frames\": [";
     } else {
         out << "cullide run: scene " << scene_label << ", method " << to_string(r.options.method)
-            << (r.options.self ? ", self-collision on" : "") << ", " << frames << " frame"
-            << (frames == 1 ? "" : "s") << "\n";
+            << (r.options.self ? ", self-collision on" : "");
+        if (visibility) {
+            out << ", resolution " << r.options.resolution << ", depth " << to_string(r.options.depth_format)
+                << ", sub-object " << r.options.subobject_triangles << " triangles";
+        }
+        if (r.options.broadphase != BroadPhase::None) out << ", broad phase " << to_string(r.options.broadphase);
+        out << ", " << frames << " frame" << (frames == 1 ? "" : "s") << "\n";
     }
     double total_ms = 0;
     std::uint64_t total_pairs = 0;
@@ -222,14 +257,43 @@ int run_command(const std::vector<std::string>& args, std::ostream& out, std::os
                 << ", \"triangles\": " << s.triangles << ", \"triangle_pairs\": " << res.pairs.size()
                 << ", \"object_pairs\": " << res.object_pairs.size()
                 << ", \"candidate_triangles\": " << s.candidate_triangles << ", \"exact_tests\": " << s.exact_tests
-                << ", \"adjacent_skipped\": " << s.adjacent_skipped << ", \"time_ms\": " << std::fixed
-                << std::setprecision(3) << s.time_ms << std::defaultfloat << "}";
+                << ", \"adjacent_skipped\": " << s.adjacent_skipped << ", \"broadphase_objects\": "
+                << s.broadphase_objects << ", \"broadphase_pairs\": " << s.broadphase_pairs
+                << ", \"pcs_boxes\": " << s.pcs_boxes << ", \"pcs_objects\": " << s.pcs_objects
+                << ", \"subobjects\": " << s.subobjects << ", \"pcs_subobjects\": " << s.pcs_subobjects
+                << ", \"subobject_pairs\": " << s.subobject_pairs << ", \"queries\": " << s.queries
+                << ", \"triangles_rasterized\": " << s.triangles_rasterized << ", \"views\": [";
+            for (std::size_t v = 0; v < s.views.size(); ++v) {
+                const ViewStats& vs = s.views[v];
+                out << (v ? ", " : "") << "{\"stage\": \"" << to_string(vs.stage) << "\", \"axis\": \""
+                    << "xyz"[vs.axis] << "\", \"before\": " << vs.items_before << ", \"after\": " << vs.items_after
+                    << ", \"queries\": " << vs.queries << ", \"triangles_rasterized\": " << vs.triangles_rasterized
+                    << "}";
+            }
+            out << "], " << std::fixed << std::setprecision(3) << "\"broadphase_ms\": " << s.broadphase_ms
+                << ", \"boxes_ms\": " << s.boxes_ms << ", \"objects_ms\": " << s.objects_ms
+                << ", \"subobjects_ms\": " << s.subobjects_ms << ", \"exact_ms\": " << s.exact_ms
+                << ", \"time_ms\": " << s.time_ms << std::defaultfloat << "}";
         } else {
             out << "frame " << f << ": " << s.objects << " objects, " << s.triangles << " triangles -> "
                 << res.pairs.size() << " colliding triangle pairs, " << res.object_pairs.size()
                 << " object pairs (" << s.candidate_triangles << " candidate triangles, " << s.exact_tests
                 << " exact tests) " << std::fixed << std::setprecision(2) << s.time_ms << " ms"
                 << std::defaultfloat << "\n";
+            if (r.options.broadphase != BroadPhase::None) {
+                out << "  broad phase: " << s.broadphase_objects << " of " << s.objects << " objects kept, "
+                    << s.broadphase_pairs << " box pairs, " << std::fixed << std::setprecision(2) << s.broadphase_ms
+                    << " ms" << std::defaultfloat << "\n";
+            }
+            if (visibility) {
+                out << "  pcs: boxes " << s.broadphase_objects << " -> " << s.pcs_boxes << " objects, triangles -> "
+                    << s.pcs_objects << " objects, sub-objects " << s.subobjects << " -> " << s.pcs_subobjects
+                    << "; " << s.subobject_pairs << " sub-object pairs; " << s.queries << " queries, "
+                    << s.triangles_rasterized << " triangles rasterized, " << s.views.size() << " views\n"
+                    << "  ms: boxes " << std::fixed << std::setprecision(2) << s.boxes_ms << ", objects "
+                    << s.objects_ms << ", sub-objects " << s.subobjects_ms << ", exact " << s.exact_ms
+                    << std::defaultfloat << "\n";
+            }
         }
         if (pairs_out.is_open()) {
             for (const TrianglePair& p : res.pairs) {

@@ -1,0 +1,111 @@
+// cullide/cullide.h: CULLIDE and R-CULLIDE, the visibility-based potentially colliding set (PCS).
+//
+// After Govindaraju, Redon, Lin and Manocha, "CULLIDE: Interactive Collision Detection Between
+// Complex Models in Large Environments using Graphics Hardware" (Graphics Hardware 2003), and
+// Govindaraju, Lin and Manocha, "Fast and Reliable Collision Culling using Graphics Hardware"
+// (R-CULLIDE, VRST 2004). The code is ours; ../shared/docs/algorithms.md sections 1-4 is the
+// specification and docs/cullide.md records every choice made where the papers are silent.
+//
+// Stages of one frame (each conservative with respect to the one before it):
+//  1. object boxes: each object's axis-aligned box (12 triangles) through the two passes of
+//     Lemma 2, in orthographic views along x, y, z fitted to the bounds of the live PCS, in rounds
+//     cycling the axis until three views in a row prune nothing (a fixpoint: the same PCS gives the
+//     same view) or 3 * max_rounds views ran;
+//  2. objects: the same with each object's triangles;
+//  3. sub-objects: each live object split into groups of `subobject_triangles` consecutive
+//     triangles; in each pass all sub-objects of an object are queried before any is written;
+//  4. exact: surviving sub-objects paired across objects by box overlap (sweep and prune), then
+//     their triangle pairs by box overlap, then the exact test of tri_tri.h.
+// Pass k of a view: clear depth; for each live object in order (pass 1) or reverse order (pass 2):
+// query its live items (GEQUAL, depth mask off, one any-samples query each), then write them
+// (LEQUAL, mask on). An item whose queries pass no sample in both passes is fully visible with
+// respect to all others in that view and leaves the PCS for good. No face culling (except the
+// offset solids of VisibilityMode::Offset, see below). The last object of a pass is not written:
+// nothing is queried after it.
+//
+// Views: raster::OrthoView (raster/transform.h) over the live PCS's bounds widened by 1/1024 of
+// their extent on each side (so float rounding never pushes geometry out of the clip volume); in
+// Offset mode the depth range is widened further until every offset solid lies inside it (a solid
+// clipped at the near or far plane would lose the faces that make it conservative).
+//
+// Objects that have nothing left to collide with (fewer than two objects with live items) are
+// pruned without a view. Self-collision is not supported (as in the papers: the sub-objects of one
+// object are never tested against each other).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "cullide/ground_truth.h"
+#include "cullide/mesh.h"
+#include "cullide/query_device.h"
+#include "cullide/result.h"
+#include "raster/types.h"
+
+namespace cullide {
+
+enum class VisibilityMode : std::uint8_t {
+    // The original: pixel-centre sampling, depth at the pixel centre (raster GL-exact mode). Can
+    // miss collisions (sampling and depth-precision errors, algorithms.md section 4).
+    GLExact,
+    // R-CULLIDE, exact bounds (ours): the triangles themselves in the emulator's conservative
+    // raster mode (RasterMode::ExactBounds: every pixel a triangle touches, writes at the zmin and
+    // queries at the zmax of the triangle over the pixel, rounded outward). Never misses. Runs only
+    // on a device that implements that mode (the emulator).
+    ExactBounds,
+    // R-CULLIDE as the paper builds it: offset solids (raster/offset_geometry.h) drawn with
+    // pixel-centre GL rules, so any GL runs it: object boxes and per-triangle boxes grown by
+    // r = sqrt(3) p / 2, objects as unions of oriented boxes; queries draw the far faces
+    // (CullFace::Front), writes the near ones (CullFace::Back). Never misses.
+    Offset,
+};
+
+enum class CullStage : std::uint8_t { Boxes, Objects, SubObjects };
+[[nodiscard]] const char* to_string(CullStage s);
+
+// One orthographic view (both passes).
+struct ViewStats {
+    CullStage stage = CullStage::Boxes;
+    int axis = 0;                            // 0 x, 1 y, 2 z: the viewing direction
+    std::uint64_t items_before = 0;          // live items (objects or sub-objects) entering the view
+    std::uint64_t items_after = 0;           // live items after it
+    std::uint64_t queries = 0;               // occlusion queries issued (both passes)
+    std::uint64_t triangles_rasterized = 0;  // triangles submitted in draws (queries and writes)
+};
+
+struct CullideOptions {
+    VisibilityMode mode = VisibilityMode::GLExact;
+    int resolution = 1024;  // pixels per side of every view, 16..16384
+    raster::DepthFormat depth_format = raster::DepthFormat::D24;
+    int subobject_triangles = 4;  // triangles per sub-object, >= 1
+    int max_rounds = 4;           // rounds of three views per stage, >= 1
+    int threads = 0;              // exact stage workers; 0 = all hardware threads
+};
+
+struct CullideStats {
+    std::uint64_t objects_in = 0;       // objects entering the visibility stages
+    std::uint64_t pcs_boxes = 0;        // objects in the PCS after the box stage
+    std::uint64_t pcs_objects = 0;      // objects in the PCS after the triangle stage
+    std::uint64_t subobjects = 0;       // sub-objects entering the sub-object stage
+    std::uint64_t pcs_subobjects = 0;   // sub-objects left after it
+    std::uint64_t subobject_pairs = 0;  // sub-object pairs across objects whose boxes overlap
+    std::uint64_t candidate_triangles = 0;  // triangles in the surviving sub-objects
+    std::uint64_t exact_tests = 0;      // triangle pairs sent to the exact test (boxes overlap)
+    std::uint64_t queries = 0;
+    std::uint64_t triangles_rasterized = 0;
+    std::vector<ViewStats> views;       // in the order they ran
+    double boxes_ms = 0, objects_ms = 0, subobjects_ms = 0, exact_ms = 0;
+};
+
+// Colliding triangle pairs found by CULLIDE among the objects listed in `active` (increasing
+// indices into `objects`; the others are treated as already pruned), canonical and sorted as
+// ground_truth.h. Every reported pair collides (exact stage); GLExact may miss pairs. Fails, naming
+// what is wrong, on invalid meshes, coordinates outside the exact range (predicates.h), bad
+// options, an unsorted or out-of-range `active`, a scene whose extent overflows, or a device error.
+[[nodiscard]] Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects,
+                                                              std::span<const std::uint32_t> active,
+                                                              const CullideOptions& options, QueryDevice& device,
+                                                              CullideStats* stats = nullptr);
+
+}  // namespace cullide

@@ -1,0 +1,44 @@
+// cullide/query_device.h: where the visibility passes of CULLIDE / R-CULLIDE run.
+//
+// The culling algorithm (cullide/cullide.h) only records raster::CommandBatch objects (draws and
+// occlusion queries in GL order) and asks a device to run them; it never touches a depth buffer
+// itself. So the very same pass sequence runs on the built-in emulator (raster/, the default) and
+// on a real GL (the OSMesa device of tests/oracle, for tests and benchmarks only).
+//
+// Contract of a device, mirroring one GL context with one depth-only framebuffer:
+//  - clear(width, height, format) makes a width x height depth target of `format` current and
+//    clears it to depth 1.0 (glClearDepth(1); glClear); the target may be reused between calls;
+//  - execute(batch) runs every command of the batch in order on the current target and returns
+//    the query results indexed like the batch's begin_query() calls (raster/command_batch.h).
+// Results must not depend on the thread count (the emulator's are bit-identical for any count).
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "cullide/result.h"
+#include "raster/command_batch.h"
+#include "raster/types.h"
+
+namespace cullide {
+
+class QueryDevice {
+   public:
+    QueryDevice() = default;
+    QueryDevice(const QueryDevice&) = delete;
+    QueryDevice& operator=(const QueryDevice&) = delete;
+    virtual ~QueryDevice() = default;
+
+    // Fails (changing nothing) when the size or format cannot be made, naming the limit.
+    [[nodiscard]] virtual Status clear(int width, int height, raster::DepthFormat format) = 0;
+    // Fails when no target was cleared yet or when the batch is invalid (the raster message).
+    [[nodiscard]] virtual Result<raster::QueryResults> execute(const raster::CommandBatch& batch) = 0;
+    // For reports: "emulator", "osmesa (llvmpipe ...)".
+    [[nodiscard]] virtual std::string name() const = 0;
+};
+
+// The built-in device: raster::execute on a raster::DepthTarget, on `threads` worker threads
+// (0 = all hardware threads; the results do not depend on it).
+[[nodiscard]] std::unique_ptr<QueryDevice> make_emulator_device(int threads);
+
+}  // namespace cullide

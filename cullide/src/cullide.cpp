@@ -1,0 +1,483 @@
+// cullide.cpp: CULLIDE's visibility stages and exact stage (see cullide/cullide.h, docs/cullide.md).
+#include "cullide/cullide.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "cullide/predicates.h"
+#include "cullide/tri_tri.h"
+#include "parallel.h"
+#include "raster/command_batch.h"
+#include "raster/offset_geometry.h"
+#include "raster/transform.h"
+
+namespace cullide {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// The 12 triangles of a box over its 8 corners; corner c takes x from bit 0, y from bit 1 and z
+// from bit 2 (lo when the bit is 0). Winding is irrelevant: boxes are drawn without face culling.
+constexpr std::array<std::uint32_t, 36> kBoxIndices = {
+    0, 4, 6, 0, 6, 2,  // -x
+    1, 3, 7, 1, 7, 5,  // +x
+    0, 1, 5, 0, 5, 4,  // -y
+    2, 6, 7, 2, 7, 3,  // +y
+    0, 2, 3, 0, 3, 1,  // -z
+    4, 5, 7, 4, 7, 6,  // +z
+};
+
+// One unit of the PCS: an object (box or whole mesh) or one sub-object. Its triangles are the
+// index range [first_index, first_index + index_count) of its object's index list.
+struct Item {
+    std::uint32_t first_index = 0;
+    std::uint32_t index_count = 0;
+    Aabb box;
+    bool live = true;
+    std::array<std::uint32_t, 2> query{};  // this view's query index in pass 1 and pass 2
+};
+
+struct ObjectGeometry {
+    std::uint32_t active_index = 0;          // position in `active`
+    std::vector<raster::Double3> positions;  // world coordinates
+    std::vector<std::uint32_t> indices;      // three per triangle
+    std::vector<Item> items;
+    std::vector<Aabb> triangle_boxes;        // sub-object stage only: one per triangle
+    // The current view's geometry, by mode: float clip positions (GLExact), double clip positions
+    // (ExactBounds), or the offset solids (Offset; per-triangle boxes at the box and sub-object
+    // stages, a union of oriented boxes at the object stage).
+    std::vector<raster::Float4> clip;
+    std::vector<raster::Double4> clip_d;
+    raster::OffsetMesh offset;
+};
+
+Aabb unite(const Aabb& a, const Aabb& b) {
+    if (a.empty()) return b;
+    if (b.empty()) return a;
+    return {{std::min(a.lo.x, b.lo.x), std::min(a.lo.y, b.lo.y), std::min(a.lo.z, b.lo.z)},
+            {std::max(a.hi.x, b.hi.x), std::max(a.hi.y, b.hi.y), std::max(a.hi.z, b.hi.z)}};
+}
+
+// Grows [lo, hi] so that geometry on its faces stays inside the clip volume after the clip
+// coordinates are rounded to float (relative error 2^-24 of the unit range): 1/1024 of the extent
+// is far above that and costs 0.2% of the resolution. A flat extent gets a margin relative to the
+// coordinates' magnitude (or 1 at the origin) so the range never collapses.
+void widen(double& lo, double& hi) {
+    const double extent = hi - lo;
+    const double magnitude = std::max(std::fabs(lo), std::fabs(hi));
+    double margin = std::max(extent * (1.0 / 1024.0), magnitude * 0x1p-40);
+    if (!(margin > 0.0)) margin = 1.0;
+    lo -= margin;
+    hi += margin;
+}
+
+// The orthographic view along `axis` (raster::OrthoView: window axes are the next two in cyclic
+// order, depth grows along the axis) fitted to `bounds` widened as above, with `extra_depth` more
+// world units before and after along the axis (Offset mode).
+Result<raster::OrthoView> make_view(int axis, const Aabb& bounds, double extra_depth, const CullideOptions& o) {
+    std::array<double, 3> lo{bounds.lo.x, bounds.lo.y, bounds.lo.z};
+    std::array<double, 3> hi{bounds.hi.x, bounds.hi.y, bounds.hi.z};
+    for (std::size_t k = 0; k < 3; ++k) {
+        widen(lo[k], hi[k]);
+        if (static_cast<int>(k) == axis) {
+            lo[k] -= extra_depth;
+            hi[k] += extra_depth;
+        }
+        if (!std::isfinite(hi[k] - lo[k]))
+            return Error{std::string("the scene's extent along ") + "xyz"[k] + " overflows a double"};
+    }
+    raster::Result<raster::OrthoView> v =
+        raster::make_ortho_view(static_cast<raster::Axis>(axis), {lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]},
+                                o.resolution, o.resolution, o.depth_format);
+    if (!v) return Error{"view: " + v.error().message};
+    return v.value();
+}
+
+// This view's geometry of one object (see ObjectGeometry).
+Status prepare_geometry(ObjectGeometry& og, CullStage stage, const raster::OrthoView& view, VisibilityMode mode) {
+    if (mode == VisibilityMode::Offset) {
+        raster::Result<raster::OffsetMesh> m =
+            stage == CullStage::Objects ? raster::object_offset_obbs(view, og.positions, og.indices)
+            : stage == CullStage::Boxes
+                // The box of the degenerate triangle (lo, hi, lo) is the object's box.
+                ? raster::triangle_offset_boxes(view, og.positions, std::array<std::uint32_t, 3>{0, 7, 0})
+                : raster::triangle_offset_boxes(view, og.positions, og.indices);
+        if (!m) return Error{"offset geometry: " + m.error().message};
+        og.offset = std::move(m).value();
+        return Status{};
+    }
+    raster::Result<std::vector<raster::Double4>> c = raster::ortho_view_to_clip(view, og.positions);
+    if (!c) return Error{"view transform: " + c.error().message};
+    if (mode == VisibilityMode::ExactBounds) {
+        og.clip_d = std::move(c).value();
+        return Status{};
+    }
+    // GL-exact: one rounding to nearest float per coordinate; the same floats go to any device.
+    og.clip.resize(c.value().size());
+    for (std::size_t i = 0; i < og.clip.size(); ++i) {
+        const raster::Double4& d = c.value()[i];
+        og.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), static_cast<float>(d.z), 1.0f};
+    }
+    return Status{};
+}
+
+std::uint64_t count_live(const std::vector<ObjectGeometry>& g) {
+    std::uint64_t n = 0;
+    for (const ObjectGeometry& og : g)
+        for (const Item& it : og.items) n += it.live ? 1 : 0;
+    return n;
+}
+
+bool has_live(const ObjectGeometry& og) {
+    return std::any_of(og.items.begin(), og.items.end(), [](const Item& it) { return it.live; });
+}
+
+// Draws one item as a query (GEQUAL, mask off) or a write (LEQUAL, mask on); returns the triangles
+// submitted.
+std::uint64_t draw_item(raster::CommandBatch& batch, const ObjectGeometry& og, const Item& it, CullStage stage,
+                        VisibilityMode mode, bool query) {
+    raster::DrawState state;
+    state.depth_func = query ? raster::DepthFunc::GEqual : raster::DepthFunc::LEqual;
+    state.depth_write = !query;
+    const auto indices = std::span<const std::uint32_t>(og.indices).subspan(it.first_index, it.index_count);
+    switch (mode) {
+        case VisibilityMode::GLExact:
+            batch.draw(raster::MeshView{og.clip, indices}, state);
+            return it.index_count / 3;
+        case VisibilityMode::ExactBounds:
+            state.mode = raster::RasterMode::ExactBounds;
+            batch.draw(raster::MeshViewD{og.clip_d, indices}, state);
+            return it.index_count / 3;
+        case VisibilityMode::Offset: {
+            // Far faces for the query, near faces for the write (R-CULLIDE).
+            state.cull_face = query ? raster::CullFace::Front : raster::CullFace::Back;
+            std::span<const std::uint32_t> solid = og.offset.indices;
+            if (stage == CullStage::SubObjects)  // 36 indices per triangle's box
+                solid = solid.subspan(std::size_t{it.first_index} * 12, std::size_t{it.index_count} * 12);
+            batch.draw(raster::MeshView{og.offset.vertices, solid}, state);
+            return solid.size() / 3;
+        }
+    }
+    return 0;
+}
+
+// Records one pass (Lemma 2) over the live objects `order`: per object, query every live item,
+// then write them all (except after the last object: nothing is queried after it).
+void record_pass(raster::CommandBatch& batch, std::vector<ObjectGeometry>& g, const std::vector<std::size_t>& order,
+                 int pass, VisibilityMode mode, ViewStats& vs) {
+    for (std::size_t k = 0; k < order.size(); ++k) {
+        ObjectGeometry& og = g[order[k]];
+        for (Item& it : og.items) {
+            if (!it.live) continue;
+            it.query[static_cast<std::size_t>(pass)] = batch.begin_query(raster::QueryKind::AnySamplesPassed);
+            vs.triangles_rasterized += draw_item(batch, og, it, vs.stage, mode, true);
+            batch.end_query();
+            ++vs.queries;
+        }
+        if (k + 1 == order.size()) continue;
+        for (const Item& it : og.items) {
+            if (!it.live) continue;
+            vs.triangles_rasterized += draw_item(batch, og, it, vs.stage, mode, false);
+        }
+    }
+}
+
+// Fits the view and prepares the live objects' geometry for it. Offset mode: widens the depth range
+// until no offset solid reaches past the near or far plane (the offset radius depends on the pixel
+// size, which widening the depth range does not change, and on the depth quantum, which it barely
+// changes, so this settles in one or two steps).
+Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_t>& order, CullStage stage, int axis,
+                    const Aabb& bounds, const CullideOptions& o) {
+    double extra_depth = 0.0;
+    for (int attempt = 0;; ++attempt) {
+        Result<raster::OrthoView> view = make_view(axis, bounds, extra_depth, o);
+        if (!view) return view.error();
+        for (std::size_t i : order)
+            if (Status s = prepare_geometry(g[i], stage, view.value(), o.mode); !s) return s;
+        if (o.mode != VisibilityMode::Offset) return Status{};
+        double overshoot = 0.0;  // in clip units beyond [-1, 1]
+        for (std::size_t i : order)
+            for (const raster::Float4& v : g[i].offset.vertices)
+                overshoot = std::max({overshoot, static_cast<double>(v.z) - 1.0, -1.0 - static_cast<double>(v.z)});
+        if (overshoot == 0.0) return Status{};
+        if (attempt == 8) return Error{"offset solids do not fit the view's depth range after 8 attempts"};
+        const double world_per_clip =
+            0.5 * ((axis == 0 ? view.value().box_max.x - view.value().box_min.x
+                    : axis == 1 ? view.value().box_max.y - view.value().box_min.y
+                                : view.value().box_max.z - view.value().box_min.z));
+        extra_depth += 2.0 * overshoot * world_per_clip;
+    }
+}
+
+// Views along x, y, z in turn until three views in a row prune nothing (then the PCS, and so every
+// further view, is unchanged) or 3 * max_rounds views ran.
+Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideOptions& o, QueryDevice& device,
+                 CullideStats& st) {
+    const int res = o.resolution;
+    int quiet = 0;
+    for (int view = 0; view < 3 * o.max_rounds && quiet < 3; ++view) {
+        std::vector<std::size_t> order;
+        Aabb bounds;
+        for (std::size_t i = 0; i < g.size(); ++i) {
+            if (!has_live(g[i])) continue;
+            order.push_back(i);
+            for (const Item& it : g[i].items)
+                if (it.live) bounds = unite(bounds, it.box);
+        }
+        if (order.size() < 2) {  // nothing left to collide with
+            for (ObjectGeometry& og : g)
+                for (Item& it : og.items) it.live = false;
+            return Status{};
+        }
+        const int axis = view % 3;
+        if (Status sv = prepare_view(g, order, stage, axis, bounds, o); !sv) return sv;
+        ViewStats vs;
+        vs.stage = stage;
+        vs.axis = axis;
+        vs.items_before = count_live(g);
+        std::array<raster::QueryResults, 2> results;
+        for (int pass = 0; pass < 2; ++pass) {
+            if (pass == 1) std::reverse(order.begin(), order.end());  // pass 2 runs backward
+            raster::CommandBatch batch(res, res);
+            record_pass(batch, g, order, pass, o.mode, vs);
+            if (Status s = device.clear(res, res, o.depth_format); !s) return s;
+            Result<raster::QueryResults> r = device.execute(batch);
+            if (!r) return r.error();
+            if (r.value().size() != batch.query_kinds().size())
+                return Error{"device returned " + std::to_string(r.value().size()) + " query results for " +
+                             std::to_string(batch.query_kinds().size()) + " queries"};
+            results[static_cast<std::size_t>(pass)] = std::move(r).value();
+        }
+        std::uint64_t pruned = 0;
+        for (std::size_t i : order) {
+            for (Item& it : g[i].items) {
+                if (it.live && results[0][it.query[0]] == 0 && results[1][it.query[1]] == 0) {
+                    it.live = false;
+                    ++pruned;
+                }
+            }
+        }
+        vs.items_after = vs.items_before - pruned;
+        st.queries += vs.queries;
+        st.triangles_rasterized += vs.triangles_rasterized;
+        st.views.push_back(vs);
+        quiet = pruned == 0 ? quiet + 1 : 0;
+    }
+    return Status{};
+}
+
+std::vector<raster::Double3> to_double3(const Mesh& m) {
+    std::vector<raster::Double3> p(m.positions.size());
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] = {m.positions[i].x, m.positions[i].y, m.positions[i].z};
+    return p;
+}
+
+Status check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active, const CullideOptions& o) {
+    if (o.resolution < 1 || o.resolution > raster::kMaxTargetSize)
+        return Error{"resolution must be in 1.." + std::to_string(raster::kMaxTargetSize) + " (got " +
+                     std::to_string(o.resolution) + ")"};
+    if (o.subobject_triangles < 1)
+        return Error{"sub-object size must be >= 1 triangle (got " + std::to_string(o.subobject_triangles) + ")"};
+    if (o.max_rounds < 1 || o.max_rounds > 1000)
+        return Error{"max_rounds must be in 1..1000 (got " + std::to_string(o.max_rounds) + ")"};
+    if (o.threads < 0) return Error{"threads must be >= 0 (got " + std::to_string(o.threads) + ")"};
+    if (Status s = validate_scene(objects); !s) return s;
+    if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
+    for (std::size_t k = 0; k < active.size(); ++k) {
+        if (active[k] >= objects.size())
+            return Error{"active object " + std::to_string(k) + " = " + std::to_string(active[k]) +
+                         " is beyond the object list (size " + std::to_string(objects.size()) + ")"};
+        if (k > 0 && active[k] <= active[k - 1])
+            return Error{"active objects must be strictly increasing (entry " + std::to_string(k) + ")"};
+        const Mesh& m = objects[active[k]];
+        if (m.triangles.size() > UINT32_MAX / 3)
+            return Error{"object " + std::to_string(active[k]) + ": too many triangles (limit 2^32 / 3)"};
+        for (std::size_t v = 0; v < m.positions.size(); ++v) {
+            for (int c = 0; c < 3; ++c) {
+                if (!predicate_coordinate_ok(m.positions[v][c])) {
+                    char value[32];
+                    std::snprintf(value, sizeof value, "%.17g", m.positions[v][c]);
+                    return Error{"object " + std::to_string(active[k]) + ": mesh '" + m.name + "': vertex " +
+                                 std::to_string(v) + " coordinate " + "xyz"[c] + " = " + value +
+                                 " is outside the exact range (0, or 2^-300 <= |x| <= 2^300)"};
+                }
+            }
+        }
+    }
+    return Status{};
+}
+
+// Surviving sub-objects paired across objects (sweep and prune on their boxes along the axis of
+// greatest extent), then their triangles by box, then exactly.
+std::vector<TrianglePair> exact_stage(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                                      const std::vector<ObjectGeometry>& g, int threads, CullideStats& st) {
+    struct Ref {
+        std::uint32_t geom, item;
+        const Aabb* box;
+    };
+    std::vector<Ref> refs;
+    Aabb all;
+    for (std::size_t i = 0; i < g.size(); ++i) {
+        for (std::size_t k = 0; k < g[i].items.size(); ++k) {
+            const Item& it = g[i].items[k];
+            if (!it.live) continue;
+            refs.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k), &it.box});
+            all = unite(all, it.box);
+            st.candidate_triangles += it.index_count / 3;
+        }
+    }
+    if (refs.empty()) return {};
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+        if (all.hi[k] - all.lo[k] > all.hi[axis] - all.lo[axis]) axis = k;
+    // (lo, geom, item) is a unique key, so the order (and the output) is deterministic.
+    std::sort(refs.begin(), refs.end(), [axis](const Ref& a, const Ref& b) {
+        if (a.box->lo[axis] != b.box->lo[axis]) return a.box->lo[axis] < b.box->lo[axis];
+        if (a.geom != b.geom) return a.geom < b.geom;
+        return a.item < b.item;
+    });
+    std::vector<std::pair<Ref, Ref>> item_pairs;
+    for (std::size_t i = 0; i < refs.size(); ++i) {
+        for (std::size_t j = i + 1; j < refs.size() && refs[j].box->lo[axis] <= refs[i].box->hi[axis]; ++j) {
+            if (refs[i].geom == refs[j].geom || !overlaps(*refs[i].box, *refs[j].box)) continue;
+            const bool first_lower = refs[i].geom < refs[j].geom;
+            item_pairs.emplace_back(first_lower ? refs[i] : refs[j], first_lower ? refs[j] : refs[i]);
+        }
+    }
+    st.subobject_pairs = item_pairs.size();
+
+    constexpr std::size_t kChunk = 64;  // sub-object pairs per task: fixed, so output is thread-independent
+    const std::size_t chunks = (item_pairs.size() + kChunk - 1) / kChunk;
+    std::vector<std::vector<TrianglePair>> found(chunks);
+    std::vector<std::uint64_t> tests(chunks, 0);
+    detail::parallel_chunks(threads, chunks, [&](std::size_t c) {
+        const std::size_t end = std::min(item_pairs.size(), (c + 1) * kChunk);
+        for (std::size_t p = c * kChunk; p < end; ++p) {
+            const ObjectGeometry& ga = g[item_pairs[p].first.geom];
+            const ObjectGeometry& gb = g[item_pairs[p].second.geom];
+            const Item& ia = ga.items[item_pairs[p].first.item];
+            const Item& ib = gb.items[item_pairs[p].second.item];
+            const std::uint32_t oa = active[ga.active_index];
+            const std::uint32_t ob = active[gb.active_index];
+            const Mesh& ma = objects[oa];
+            const Mesh& mb = objects[ob];
+            for (std::uint32_t ta = ia.first_index / 3; ta < (ia.first_index + ia.index_count) / 3; ++ta) {
+                for (std::uint32_t tb = ib.first_index / 3; tb < (ib.first_index + ib.index_count) / 3; ++tb) {
+                    if (!overlaps(ga.triangle_boxes[ta], gb.triangle_boxes[tb])) continue;
+                    ++tests[c];
+                    const Tri& a = ma.triangles[ta];
+                    const Tri& b = mb.triangles[tb];
+                    if (tri_tri_intersect(ma.positions[a[0]], ma.positions[a[1]], ma.positions[a[2]],
+                                          mb.positions[b[0]], mb.positions[b[1]], mb.positions[b[2]]))
+                        found[c].push_back({oa, ta, ob, tb});
+                }
+            }
+        }
+    });
+    std::vector<TrianglePair> pairs;
+    for (std::size_t c = 0; c < chunks; ++c) {
+        st.exact_tests += tests[c];
+        pairs.insert(pairs.end(), found[c].begin(), found[c].end());
+    }
+    std::sort(pairs.begin(), pairs.end());
+    return pairs;
+}
+
+}  // namespace
+
+const char* to_string(CullStage s) {
+    switch (s) {
+        case CullStage::Boxes:
+            return "boxes";
+        case CullStage::Objects:
+            return "objects";
+        case CullStage::SubObjects:
+            return "subobjects";
+    }
+    return "?";
+}
+
+Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                                                const CullideOptions& options, QueryDevice& device,
+                                                CullideStats* stats) {
+    if (Status s = check_inputs(objects, active, options); !s) return s.error();
+    CullideStats st;
+    st.objects_in = active.size();
+
+    // Stage 1: object boxes.
+    auto t0 = Clock::now();
+    std::vector<ObjectGeometry> boxes(active.size());
+    for (std::size_t k = 0; k < active.size(); ++k) {
+        ObjectGeometry& og = boxes[k];
+        og.active_index = static_cast<std::uint32_t>(k);
+        const Aabb b = mesh_bounds(objects[active[k]]);
+        og.positions.resize(8);
+        for (std::size_t c = 0; c < 8; ++c)
+            og.positions[c] = {(c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z};
+        og.indices.assign(kBoxIndices.begin(), kBoxIndices.end());
+        og.items.push_back({0, 36, b, true, {}});
+    }
+    if (Status s = run_stage(boxes, CullStage::Boxes, options, device, st); !s) return s.error();
+    st.pcs_boxes = count_live(boxes);
+    st.boxes_ms = ms_since(t0);
+
+    // Stage 2: whole objects.
+    t0 = Clock::now();
+    std::vector<ObjectGeometry> whole;
+    for (const ObjectGeometry& b : boxes) {
+        if (!b.items[0].live) continue;
+        const Mesh& m = objects[active[b.active_index]];
+        ObjectGeometry og;
+        og.active_index = b.active_index;
+        og.positions = to_double3(m);
+        og.indices.reserve(m.triangles.size() * 3);
+        for (const Tri& t : m.triangles) og.indices.insert(og.indices.end(), t.begin(), t.end());
+        og.items.push_back({0, static_cast<std::uint32_t>(og.indices.size()), b.items[0].box, true, {}});
+        whole.push_back(std::move(og));
+    }
+    if (Status s = run_stage(whole, CullStage::Objects, options, device, st); !s) return s.error();
+    st.pcs_objects = count_live(whole);
+    st.objects_ms = ms_since(t0);
+
+    // Stage 3: sub-objects of consecutive triangles (neighbours in meshes stored strip- or
+    // patch-wise; see docs/cullide.md for what this choice costs on scrambled meshes).
+    t0 = Clock::now();
+    std::vector<ObjectGeometry> subs;
+    const auto group = static_cast<std::size_t>(options.subobject_triangles);
+    for (ObjectGeometry& og : whole) {
+        if (!og.items[0].live) continue;
+        const Mesh& m = objects[active[og.active_index]];
+        og.items.clear();
+        og.triangle_boxes.resize(m.triangles.size());
+        for (std::size_t t = 0; t < m.triangles.size(); ++t) og.triangle_boxes[t] = triangle_bounds(m, t);
+        for (std::size_t first = 0; first < m.triangles.size(); first += group) {
+            const std::size_t last = std::min(m.triangles.size(), first + group);
+            Aabb b;
+            for (std::size_t t = first; t < last; ++t) b = unite(b, og.triangle_boxes[t]);
+            og.items.push_back(
+                {static_cast<std::uint32_t>(first * 3), static_cast<std::uint32_t>((last - first) * 3), b, true, {}});
+        }
+        st.subobjects += og.items.size();
+        subs.push_back(std::move(og));
+    }
+    if (Status s = run_stage(subs, CullStage::SubObjects, options, device, st); !s) return s.error();
+    st.pcs_subobjects = count_live(subs);
+    st.subobjects_ms = ms_since(t0);
+
+    // Stage 4: exact.
+    t0 = Clock::now();
+    std::vector<TrianglePair> pairs = exact_stage(objects, active, subs, options.threads, st);
+    st.exact_ms = ms_since(t0);
+    if (stats != nullptr) *stats = std::move(st);
+    return pairs;
+}
+
+}  // namespace cullide

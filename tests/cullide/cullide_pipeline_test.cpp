@@ -1,0 +1,327 @@
+// CULLIDE / R-CULLIDE pipeline against the exact ground truth (ground_truth.h): the reliable modes
+// report exactly the ground-truth pairs, the GL-exact mode never reports a false pair and its misses
+// are counted, results do not depend on the thread count, options and errors behave.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "cullide/cullide.h"
+#include "cullide/ground_truth.h"
+#include "cullide/pipeline.h"
+#include "cullide/scenes.h"
+
+namespace {
+
+using cullide::Method;
+using cullide::TrianglePair;
+
+std::vector<TrianglePair> truth(const std::vector<cullide::Mesh>& objects) {
+    auto r = cullide::exact_pairs(objects);
+    REQUIRE(r.ok());
+    return r.value();
+}
+
+cullide::FrameResult run(const std::vector<cullide::Mesh>& objects, Method m, int resolution, int threads = 2,
+                         cullide::BroadPhase bp = cullide::BroadPhase::None) {
+    cullide::RunOptions o;
+    o.method = m;
+    o.resolution = resolution;
+    o.threads = threads;
+    o.broadphase = bp;
+    auto r = cullide::process_frame(objects, o);
+    if (!r) FAIL(r.error().message);
+    return r.value();
+}
+
+// Pairs of `found` missing from `expected`-sized truth; `found` must be a subset of truth.
+std::size_t misses(const std::vector<TrianglePair>& found, const std::vector<TrianglePair>& exact) {
+    CHECK(std::includes(exact.begin(), exact.end(), found.begin(), found.end()));  // no false pair
+    return exact.size() - found.size();
+}
+
+cullide::Mesh cube(cullide::Vec3 centre, double side, std::string name) {
+    // A cube turned by fixed angles about z then x, so no face is parallel to a view axis (an
+    // axis-aligned face is edge-on in two of the three views and GL-exact never samples it).
+    const double a = 0.3, b = 0.5;
+    const double ca = std::cos(a), sa = std::sin(a), cb = std::cos(b), sb = std::sin(b);
+    cullide::Mesh m;
+    m.name = std::move(name);
+    for (int c = 0; c < 8; ++c) {
+        double x = side * ((c & 1) - 0.5), y = side * (((c >> 1) & 1) - 0.5), z = side * (((c >> 2) & 1) - 0.5);
+        const double x1 = x * ca - y * sa, y1 = x * sa + y * ca;
+        const double y2 = y1 * cb - z * sb, z2 = y1 * sb + z * cb;
+        m.positions.push_back({centre.x + x1, centre.y + y2, centre.z + z2});
+    }
+    m.triangles = {{0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}, {0, 1, 5}, {0, 5, 4},
+                   {2, 6, 7}, {2, 7, 3}, {0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}};
+    return m;
+}
+
+cullide::Mesh triangle(cullide::Vec3 c, double s, cullide::Vec3 p, cullide::Vec3 q, cullide::Vec3 r,
+                       std::string name) {
+    cullide::Mesh m;
+    m.name = std::move(name);
+    m.positions = {c + s * p, c + s * q, c + s * r};
+    m.triangles = {{0, 1, 2}};
+    return m;
+}
+
+// Two pairs of crossing cubes at opposite corners of a room of side `room` keep the views wide;
+// in the middle two crossing triangles of size ~1 are far smaller than a pixel at low resolution.
+std::vector<cullide::Mesh> tiny_crossing_scene(double room) {
+    const cullide::Vec3 mid{room / 2, room / 2, room / 2};
+    return {cube({5, 5, 5}, 10, "a"),
+            cube({10, 10, 10}, 10, "b"),
+            cube({room - 5, room - 5, room - 5}, 10, "c"),
+            cube({room - 10, room - 10, room - 10}, 10, "d"),
+            triangle(mid, 0.5, {1, 0.1, 0.3}, {-0.5, 0.87, -0.2}, {-0.5, -0.87, 0.1}, "t1"),
+            triangle(mid, 0.5, {0.3, 0.9, -0.1}, {-0.2, -0.3, 0.95}, {0.1, -0.4, -0.9}, "t2")};
+}
+
+bool has_object_pair(const std::vector<TrianglePair>& pairs, std::uint32_t a, std::uint32_t b) {
+    return std::any_of(pairs.begin(), pairs.end(),
+                       [&](const TrianglePair& p) { return p.object_a == a && p.object_b == b; });
+}
+
+}  // namespace
+
+TEST_CASE("the reliable methods report exactly the ground-truth pairs on every built-in scene") {
+    const double scale = std::getenv("CULLIDE_PIPELINE_SCALE") ? std::atof(std::getenv("CULLIDE_PIPELINE_SCALE")) : 0.05;
+    std::uint64_t total_pairs = 0;
+    for (const std::string& name : cullide::scene_names()) {
+        cullide::SceneOptions so;
+        so.scale = scale;
+        so.mesh_dir = "";  // procedural stand-ins: the same scene everywhere
+        auto scene = cullide::make_scene(name, so);
+        REQUIRE(scene.ok());
+        for (int frame : {0, 5}) {
+            const cullide::Frame objects = scene.value()->frame(frame);
+            const auto exact = truth(objects);
+            total_pairs += exact.size();
+            for (int resolution : {128}) {
+                for (Method m : {Method::RCullide, Method::RCullideOffset}) {
+                    CAPTURE(name);
+                    CAPTURE(frame);
+                    CAPTURE(resolution);
+                    CAPTURE(cullide::to_string(m));
+                    const cullide::FrameResult r = run(objects, m, resolution);
+                    CHECK(r.pairs == exact);
+                    CHECK(r.stats.pcs_subobjects <= r.stats.subobjects);
+                }
+                CAPTURE(name);
+                CAPTURE(frame);
+                CAPTURE(resolution);
+                const cullide::FrameResult c = run(objects, Method::Cullide, resolution);
+                const std::size_t missed = misses(c.pairs, exact);
+                MESSAGE(name << " frame " << frame << " resolution " << resolution << ": cullide missed " << missed
+                             << " of " << exact.size() << " pairs");
+            }
+        }
+    }
+    CHECK(total_pairs > 1000);  // the scenes must collide, or the equality above proves little
+}
+
+TEST_CASE("cullide misses a collision smaller than a pixel and finds it when pixels are small enough") {
+    const auto objects = tiny_crossing_scene(100.0);
+    const auto exact = truth(objects);
+    REQUIRE(has_object_pair(exact, 4, 5));  // the two tiny triangles do cross
+    REQUIRE(has_object_pair(exact, 0, 1));
+    REQUIRE(has_object_pair(exact, 2, 3));
+    for (Method m : {Method::RCullide, Method::RCullideOffset}) {
+        for (int resolution : {16, 64, 1024}) {
+            CAPTURE(cullide::to_string(m));
+            CAPTURE(resolution);
+            CHECK(run(objects, m, resolution).pairs == exact);
+        }
+    }
+    // Sampling error (algorithms.md section 4): at 64 pixels a pixel is 1.6 units, the triangles
+    // cover no pixel centre, make no fragment, and so look fully visible.
+    const cullide::FrameResult low = run(objects, Method::Cullide, 64);
+    CHECK_FALSE(has_object_pair(low.pairs, 4, 5));
+    CHECK(misses(low.pairs, exact) > 0);
+    const cullide::FrameResult high = run(objects, Method::Cullide, 4096);
+    CHECK(has_object_pair(high.pairs, 4, 5));
+    CHECK(misses(high.pairs, exact) < misses(low.pairs, exact));
+}
+
+TEST_CASE("cullide misses faces that are edge-on in the views, whatever the resolution") {
+    // Two axis-aligned cubes crossing: every face is parallel to two view axes, so each sub-object of
+    // one face pair is edge-on (no fragments, hence fully visible) in some view and is pruned.
+    auto aligned = [](cullide::Vec3 lo, std::string name) {
+        cullide::Mesh m;
+        m.name = std::move(name);
+        for (int c = 0; c < 8; ++c)
+            m.positions.push_back({lo.x + 10.0 * (c & 1), lo.y + 10.0 * ((c >> 1) & 1), lo.z + 10.0 * ((c >> 2) & 1)});
+        m.triangles = {{0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}, {0, 1, 5}, {0, 5, 4},
+                       {2, 6, 7}, {2, 7, 3}, {0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}};
+        return m;
+    };
+    const std::vector<cullide::Mesh> objects{aligned({0, 0, 0}, "a"), aligned({5, 5, 5}, "b")};
+    const auto exact = truth(objects);
+    REQUIRE_FALSE(exact.empty());
+    for (int resolution : {64, 256}) {
+        CAPTURE(resolution);
+        CHECK(run(objects, Method::Cullide, resolution).pairs.empty());
+        CHECK(run(objects, Method::RCullide, resolution).pairs == exact);
+        CHECK(run(objects, Method::RCullideOffset, resolution).pairs == exact);
+    }
+}
+
+TEST_CASE("pairs and every PCS figure are the same for 1, 2, 3 and 8 threads") {
+    cullide::SceneOptions so;
+    so.scale = 0.05;
+    auto scene = cullide::make_scene("tori", so);
+    REQUIRE(scene.ok());
+    const cullide::Frame objects = scene.value()->frame(2);
+    for (Method m : {Method::Cullide, Method::RCullide, Method::RCullideOffset}) {
+        const cullide::FrameResult one = run(objects, m, 128, 1);
+        REQUIRE_FALSE(one.pairs.empty());
+        for (int threads : {2, 3, 8}) {
+            CAPTURE(cullide::to_string(m));
+            CAPTURE(threads);
+            const cullide::FrameResult r = run(objects, m, 128, threads);
+            CHECK(r.pairs == one.pairs);
+            CHECK(r.stats.queries == one.stats.queries);
+            CHECK(r.stats.triangles_rasterized == one.stats.triangles_rasterized);
+            CHECK(r.stats.exact_tests == one.stats.exact_tests);
+            REQUIRE(r.stats.views.size() == one.stats.views.size());
+            for (std::size_t v = 0; v < r.stats.views.size(); ++v) {
+                CHECK(r.stats.views[v].items_after == one.stats.views[v].items_after);
+                CHECK(r.stats.views[v].queries == one.stats.views[v].queries);
+            }
+        }
+    }
+}
+
+TEST_CASE("the statistics add up: views, queries and the PCS shrink monotonically") {
+    cullide::SceneOptions so;
+    so.scale = 0.1;
+    auto scene = cullide::make_scene("cylinders", so);
+    REQUIRE(scene.ok());
+    const cullide::Frame objects = scene.value()->frame(0);
+    const cullide::FrameResult r = run(objects, Method::Cullide, 256);
+    const cullide::FrameStats& s = r.stats;
+    CHECK(s.objects == objects.size());
+    CHECK(s.broadphase_objects == objects.size());
+    CHECK(s.pcs_boxes <= s.broadphase_objects);
+    CHECK(s.pcs_objects <= s.pcs_boxes);
+    CHECK(s.pcs_subobjects <= s.subobjects);
+    REQUIRE_FALSE(s.views.empty());
+    std::uint64_t queries = 0, tris = 0;
+    for (std::size_t v = 0; v < s.views.size(); ++v) {
+        CAPTURE(v);
+        const cullide::ViewStats& vs = s.views[v];
+        CHECK(vs.items_after <= vs.items_before);
+        CHECK(vs.queries == 2 * vs.items_before);  // one query per live item per pass
+        queries += vs.queries;
+        tris += vs.triangles_rasterized;
+        if (v > 0 && s.views[v - 1].stage == vs.stage) CHECK(vs.items_before == s.views[v - 1].items_after);
+    }
+    CHECK(queries == s.queries);
+    CHECK(tris == s.triangles_rasterized);
+    // Within a stage the views cycle x, y, z from x.
+    std::size_t first = 0;
+    for (std::size_t v = 0; v < s.views.size(); ++v) {
+        if (v > 0 && s.views[v].stage != s.views[v - 1].stage) first = v;
+        CHECK(s.views[v].axis == static_cast<int>((v - first) % 3));
+    }
+    CHECK(s.candidate_triangles <= s.triangles);
+    CHECK(r.pairs.size() <= s.exact_tests);
+}
+
+TEST_CASE("the broad phase keeps the ground truth and drops objects that overlap nothing") {
+    auto objects = tiny_crossing_scene(100.0);
+    objects.push_back(cube({50, 20, 80}, 3, "alone"));  // overlaps no other box
+    const auto exact = truth(objects);
+    for (cullide::BroadPhase bp : {cullide::BroadPhase::SpatialHash, cullide::BroadPhase::SweepAndPrune,
+                                   cullide::BroadPhase::BruteForce}) {
+        for (Method m : {Method::Exact, Method::RCullide, Method::RCullideOffset}) {
+            CAPTURE(cullide::to_string(bp));
+            CAPTURE(cullide::to_string(m));
+            const cullide::FrameResult r = run(objects, m, 64, 2, bp);
+            CHECK(r.pairs == exact);
+            CHECK(r.stats.broadphase_objects == objects.size() - 1);
+            CHECK(r.stats.broadphase_pairs == 3);
+        }
+    }
+}
+
+TEST_CASE("bad options and inputs are errors that name the problem") {
+    const auto objects = tiny_crossing_scene(100.0);
+    cullide::RunOptions o;
+    o.method = Method::Cullide;
+    o.self = true;
+    auto r = cullide::process_frame(objects, o);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().message.find("self-collision is not supported by method 'cullide'") != std::string::npos);
+
+    o.self = false;
+    o.subobject_triangles = 0;
+    r = cullide::process_frame(objects, o);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().message.find("sub-object size must be >= 1") != std::string::npos);
+
+    o.subobject_triangles = 4;
+    o.resolution = 0;
+    r = cullide::process_frame(objects, o);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().message.find("resolution must be in 1..16384 (got 0)") != std::string::npos);
+
+    o.resolution = 64;
+    auto bad = objects;
+    bad[2].triangles[3][1] = 99;
+    r = cullide::process_frame(bad, o);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().message.find("object 2") != std::string::npos);
+
+    auto device = cullide::make_emulator_device(1);
+    const std::vector<std::uint32_t> unsorted{1, 0};
+    auto p = cullide::cullide_pairs(objects, unsorted, {}, *device);
+    REQUIRE_FALSE(p.ok());
+    CHECK(p.error().message.find("strictly increasing (entry 1)") != std::string::npos);
+    const std::vector<std::uint32_t> beyond{0, 9};
+    p = cullide::cullide_pairs(objects, beyond, {}, *device);
+    REQUIRE_FALSE(p.ok());
+    CHECK(p.error().message.find("active object 1 = 9 is beyond the object list (size 6)") != std::string::npos);
+
+    CHECK_FALSE(cullide::parse_method("rcullide-offsets").ok());
+    CHECK(cullide::parse_method("rcullide-offset").value() == Method::RCullideOffset);
+    CHECK(cullide::parse_depth_format("d32f").value() == raster::DepthFormat::D32F);
+    CHECK(cullide::parse_depth_format("d8").error().message.find("valid: d16, d24, d32f") != std::string::npos);
+    CHECK(cullide::parse_broadphase("sap").value() == cullide::BroadPhase::SweepAndPrune);
+}
+
+TEST_CASE("every sub-object size and depth format gives the ground truth in the reliable modes") {
+    cullide::SceneOptions so;
+    so.scale = 0.05;
+    auto scene = cullide::make_scene("breaking", so);
+    REQUIRE(scene.ok());
+    const cullide::Frame objects = scene.value()->frame(1);
+    const auto exact = truth(objects);
+    REQUIRE_FALSE(exact.empty());
+    for (int group : {1, 3, 16}) {
+        for (raster::DepthFormat f : {raster::DepthFormat::D16, raster::DepthFormat::D24, raster::DepthFormat::D32F}) {
+            if (group != 3 && f != raster::DepthFormat::D24) continue;  // every format once, every size once
+            for (Method m : {Method::Cullide, Method::RCullide, Method::RCullideOffset}) {
+                CAPTURE(group);
+                CAPTURE(cullide::to_string(f));
+                CAPTURE(cullide::to_string(m));
+                cullide::RunOptions o;
+                o.method = m;
+                o.resolution = 128;
+                o.subobject_triangles = group;
+                o.depth_format = f;
+                auto r = cullide::process_frame(objects, o);
+                REQUIRE(r.ok());
+                if (m == Method::Cullide)
+                    misses(r.value().pairs, exact);
+                else
+                    CHECK(r.value().pairs == exact);
+            }
+        }
+    }
+}
