@@ -116,15 +116,22 @@ Result<OffsetMesh> triangle_offset_boxes(const OrthoView& view, std::span<const 
             lo = {std::min(lo.x, a.x), std::min(lo.y, a.y), std::min(lo.z, a.z)};
             hi = {std::max(hi.x, a.x), std::max(hi.y, a.y), std::max(hi.z, a.z)};
         }
-        // Clip bounds in double, then pushed out by more than their rounding error (each of the
-        // three operations errs by <= 1/2 ulp; 2^-50 |c| + 2^-52 covers all three), then rounded
-        // outward to float.
+        // Clip bounds in double, then pushed out by more than their rounding error, then rounded
+        // outward to float. The error is not relative to the result: a - r and (a - r) - lo each
+        // err by u |operand| (u = 2^-53), the view's scale 2 / (hi - lo) by 2u, the product and the
+        // final "- 1" by u each. With M = (|a| + r + |lo|) * scale (the largest magnitude met
+        // before the "- 1"), the total is below 6u M + u |c|; the margin (M + |c| + 1) 2^-49 = 16u
+        // (M + |c| + 1) covers it with room for its own rounding. (A margin relative to |c| alone
+        // is too small when the view box lies far from the origin: the aarch64 run found one.)
         float cmin[3], cmax[3];
         for (int k = 0; k < 3; ++k) {
-            const double l = (comp(lo, k) - r - comp(f.lo, k)) * comp(f.scale, k) - 1.0;
-            const double h = (comp(hi, k) + r - comp(f.lo, k)) * comp(f.scale, k) - 1.0;
-            cmin[k] = round_down(l - (std::fabs(l) * 0x1p-50 + 0x1p-52));
-            cmax[k] = round_up(h + (std::fabs(h) * 0x1p-50 + 0x1p-52));
+            const double scale = comp(f.scale, k);
+            const double l = (comp(lo, k) - r - comp(f.lo, k)) * scale - 1.0;
+            const double h = (comp(hi, k) + r - comp(f.lo, k)) * scale - 1.0;
+            const double big_l = (std::fabs(comp(lo, k)) + r + std::fabs(comp(f.lo, k))) * scale;
+            const double big_h = (std::fabs(comp(hi, k)) + r + std::fabs(comp(f.lo, k))) * scale;
+            cmin[k] = round_down(l - (big_l + std::fabs(l) + 1.0) * 0x1p-49);
+            cmax[k] = round_up(h + (big_h + std::fabs(h) + 1.0) * 0x1p-49);
             if (!std::isfinite(cmin[k]) || !std::isfinite(cmax[k]))
                 return Error{"triangle_offset_boxes: triangle " + std::to_string(t / 3) +
                              ": its box overflows float in clip space"};

@@ -40,8 +40,11 @@ raster::OrthoView random_view(test::Rng& rng, raster::Axis axis, raster::DepthFo
     const Double3 lo{rng.uniform(-5, 5) * s, rng.uniform(-5, 5) * s, rng.uniform(-5, 5) * s};
     const Double3 hi{lo.x + rng.uniform(0.5, 8) * s, lo.y + rng.uniform(0.5, 8) * s,
                      lo.z + rng.uniform(0.5, 8) * s};
-    auto v = raster::make_ortho_view(axis, lo, hi, 16 + static_cast<int>(rng.below(300)),
-                                     16 + static_cast<int>(rng.below(300)), f);
+    // Sequenced explicitly: the order in which function arguments are evaluated is unspecified
+    // (g++ on x86-64 and on aarch64 differ), and the inputs must be the same everywhere.
+    const int width = 16 + static_cast<int>(rng.below(300));
+    const int height = 16 + static_cast<int>(rng.below(300));
+    auto v = raster::make_ortho_view(axis, lo, hi, width, height, f);
     REQUIRE(v.ok());
     return v.value();
 }
@@ -156,12 +159,15 @@ TEST_CASE("Offset boxes contain every triangle grown by the paper's radius, exac
         for (std::size_t t = 0; t < 3; ++t) {
             CAPTURE(t);
             std::vector<Double3> tri = {pts[idx[3 * t]], pts[idx[3 * t + 1]], pts[idx[3 * t + 2]]};
-            // Depth is clamped to the view's range, so only check balls inside it along the depth axis.
+            // Boxes are clamped to the view's depth range and to clip x, y in [-2, 2] (half a view
+            // beyond each visible edge), so only balls inside that region must be contained.
             const Double3 lo = raster::view_axes(v, v.box_min), hi = raster::view_axes(v, v.box_max);
             bool inside = true;
             for (const auto& p : tri) {
-                const double d = raster::view_axes(v, p).z;
-                inside = inside && d - r >= lo.z && d + r <= hi.z;
+                const Double3 q = raster::view_axes(v, p);
+                inside = inside && q.z - r >= lo.z && q.z + r <= hi.z;
+                inside = inside && q.x - r >= lo.x - 0.5 * (hi.x - lo.x) && q.x + r <= hi.x + 0.5 * (hi.x - lo.x);
+                inside = inside && q.y - r >= lo.y - 0.5 * (hi.y - lo.y) && q.y + r <= hi.y + 0.5 * (hi.y - lo.y);
             }
             if (inside) CHECK(box_contains_balls(v, boxes.value(), t, tri, r));
         }
