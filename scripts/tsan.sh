@@ -30,8 +30,16 @@ if [ ! -f "$tbb/install/lib/cmake/TBB/TBBConfig.cmake" ]; then
         echo "cullide: the onetbb source package is needed and adding a deb-src entry needs root" >&2
         exit 1
       fi
-      printf 'Types: deb-src\nURIs: http://deb.debian.org/debian\nSuites: bookworm bookworm-updates\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' \
-        >/etc/apt/sources.list.d/cullide-tbb-src.sources
+      # Source entries mirror the binary ones this machine already uses (deb822 or one-line form).
+      if [ -f /etc/apt/sources.list.d/debian.sources ]; then
+        sed 's/^Types: deb$/Types: deb-src/' /etc/apt/sources.list.d/debian.sources \
+          >/etc/apt/sources.list.d/cullide-tbb-src.sources
+      elif [ -f /etc/apt/sources.list ]; then
+        grep '^deb ' /etc/apt/sources.list | sed 's/^deb /deb-src /' >/etc/apt/sources.list.d/cullide-tbb-src.list
+      else
+        echo "cullide: no apt sources found to derive a deb-src entry from" >&2
+        exit 1
+      fi
       apt-get update -qq
     fi
     command -v dpkg-source >/dev/null || { export DEBIAN_FRONTEND=noninteractive; apt-get install -y -qq dpkg-dev >/dev/null; }
