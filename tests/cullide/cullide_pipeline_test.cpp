@@ -13,35 +13,16 @@
 #include "cullide/ground_truth.h"
 #include "cullide/pipeline.h"
 #include "cullide/scenes.h"
+#include "pipeline_test_util.h"
 
 namespace {
 
 using cullide::Method;
 using cullide::TrianglePair;
 
-std::vector<TrianglePair> truth(const std::vector<cullide::Mesh>& objects) {
-    auto r = cullide::exact_pairs(objects);
-    REQUIRE(r.ok());
-    return r.value();
-}
-
-cullide::FrameResult run(const std::vector<cullide::Mesh>& objects, Method m, int resolution, int threads = 2,
-                         cullide::BroadPhase bp = cullide::BroadPhase::None) {
-    cullide::RunOptions o;
-    o.method = m;
-    o.resolution = resolution;
-    o.threads = threads;
-    o.broadphase = bp;
-    auto r = cullide::process_frame(objects, o);
-    if (!r) FAIL(r.error().message);
-    return r.value();
-}
-
-// Pairs of `found` missing from `expected`-sized truth; `found` must be a subset of truth.
-std::size_t misses(const std::vector<TrianglePair>& found, const std::vector<TrianglePair>& exact) {
-    CHECK(std::includes(exact.begin(), exact.end(), found.begin(), found.end()));  // no false pair
-    return exact.size() - found.size();
-}
+using test::misses;
+using test::run;
+using test::truth;
 
 cullide::Mesh cube(cullide::Vec3 centre, double side, std::string name) {
     // A cube turned by fixed angles about z then x, so no face is parallel to a view axis (an

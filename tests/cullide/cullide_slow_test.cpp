@@ -12,31 +12,16 @@
 #include "cullide/mesh_io.h"
 #include "cullide/pipeline.h"
 #include "cullide/scenes.h"
+#include "pipeline_test_util.h"
 
 namespace {
 
 using cullide::Method;
 using cullide::TrianglePair;
 
-std::vector<TrianglePair> truth(const std::vector<cullide::Mesh>& objects) {
-    auto r = cullide::exact_pairs(objects);
-    REQUIRE(r.ok());
-    return r.value();
-}
-
-cullide::FrameResult run(const std::vector<cullide::Mesh>& objects, Method m, int resolution) {
-    cullide::RunOptions o;
-    o.method = m;
-    o.resolution = resolution;
-    auto r = cullide::process_frame(objects, o);
-    if (!r) FAIL(r.error().message);
-    return r.value();
-}
-
-std::size_t misses(const std::vector<TrianglePair>& found, const std::vector<TrianglePair>& exact) {
-    CHECK(std::includes(exact.begin(), exact.end(), found.begin(), found.end()));  // no false pair
-    return exact.size() - found.size();
-}
+using test::misses;
+using test::run;
+using test::truth;
 
 }  // namespace
 

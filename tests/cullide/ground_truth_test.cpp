@@ -10,6 +10,7 @@
 #include "cullide/ground_truth.h"
 #include "cullide/mesh_io.h"
 #include "cullide/tri_tri.h"
+#include "brute_force_pairs.h"
 #include "test_rng.h"
 
 using cullide::Mesh;
@@ -17,36 +18,6 @@ using cullide::TrianglePair;
 using cullide::Vec3;
 
 namespace {
-
-// All pairs, all triangles: the slow twin with the same contract.
-std::vector<TrianglePair> brute_force_pairs(const std::vector<Mesh>& objects, bool self) {
-    std::vector<TrianglePair> out;
-    for (std::uint32_t a = 0; a < objects.size(); ++a) {
-        for (std::uint32_t b = a; b < objects.size(); ++b) {
-            if (a == b && !self) continue;
-            const Mesh& ma = objects[a];
-            const Mesh& mb = objects[b];
-            for (std::uint32_t i = 0; i < ma.triangles.size(); ++i) {
-                for (std::uint32_t j = (a == b ? i + 1 : 0); j < mb.triangles.size(); ++j) {
-                    const auto& ta = ma.triangles[i];
-                    const auto& tb = mb.triangles[j];
-                    if (a == b) {
-                        bool adjacent = false;  // naive welding: equal coordinates are one vertex
-                        for (auto u : ta)
-                            for (auto v : tb) adjacent = adjacent || ma.positions[u] == mb.positions[v];
-                        if (adjacent) continue;
-                    }
-                    if (cullide::tri_tri_intersect(ma.positions[ta[0]], ma.positions[ta[1]], ma.positions[ta[2]],
-                                                   mb.positions[tb[0]], mb.positions[tb[1]], mb.positions[tb[2]])) {
-                        out.push_back({a, i, b, j});
-                    }
-                }
-            }
-        }
-    }
-    std::sort(out.begin(), out.end());  // generated in (a, b, i, j) order; canonical is (a, i, b, j)
-    return out;
-}
 
 // A soup of small random triangles in a box, some objects overlapping; coordinates on a coarse
 // dyadic grid so that touching and coplanar contacts really happen.
@@ -89,7 +60,7 @@ TEST_CASE("ground truth equals the brute-force twin on 300 random scenes, with a
         std::vector<Mesh> scene = random_scene(seed, 2 + static_cast<int>(seed % 5), 6 + static_cast<int>(seed % 13), self);
         auto pairs = cullide::exact_pairs(scene, {self, 1});
         REQUIRE(pairs.ok());
-        const auto expected = brute_force_pairs(scene, self);
+        const auto expected = test::brute_force_pairs(scene, self);
         CHECK(pairs.value() == expected);
         total_pairs += expected.size();
         for (const auto& p : expected) total_self_pairs += p.object_a == p.object_b;

@@ -20,6 +20,7 @@
 #include "cullide/ground_truth.h"
 #include "cullide/scenes.h"
 #include "cullide/tri_tri.h"
+#include "brute_force_pairs.h"
 #include "digest.h"
 #include "raster/raster.h"
 #include "spatialhash/broad_phase.h"
@@ -117,36 +118,6 @@ Outcome run_method(const std::string& method, const cullide::Frame& frame, bool 
     return out;
 }
 
-// The independent twin of the exact method: every triangle pair, no prefilter, one thread, naive
-// welding for self pairs (equal coordinates are one vertex, docs/conventions.md).
-std::vector<TrianglePair> brute_force_pairs(const cullide::Frame& objects, bool self) {
-    std::vector<TrianglePair> out;
-    for (std::uint32_t a = 0; a < objects.size(); ++a) {
-        for (std::uint32_t b = a; b < objects.size(); ++b) {
-            if (a == b && !self) continue;
-            const Mesh& ma = objects[a];
-            const Mesh& mb = objects[b];
-            for (std::uint32_t i = 0; i < ma.triangles.size(); ++i) {
-                for (std::uint32_t j = (a == b ? i + 1 : 0); j < mb.triangles.size(); ++j) {
-                    const auto& ta = ma.triangles[i];
-                    const auto& tb = mb.triangles[j];
-                    bool adjacent = false;
-                    if (a == b) {
-                        for (auto u : ta)
-                            for (auto v : tb) adjacent = adjacent || ma.positions[u] == mb.positions[v];
-                    }
-                    if (!adjacent &&
-                        cullide::tri_tri_intersect(ma.positions[ta[0]], ma.positions[ta[1]], ma.positions[ta[2]],
-                                                   mb.positions[tb[0]], mb.positions[tb[1]], mb.positions[tb[2]])) {
-                        out.push_back({a, i, b, j});
-                    }
-                }
-            }
-        }
-    }
-    std::sort(out.begin(), out.end());
-    return out;
-}
 
 // ---- Raster -----------------------------------------------------------------------------------
 
@@ -274,7 +245,7 @@ TEST_CASE("golden digests: scene frames and exact pairs of every built-in scene,
         // native run: the literals already tie every platform to the pairs it checked.
         if (method == "exact" && !reliability::quick_mode()) {
             // The pinned pairs are right, not only stable: the brute-force twin agrees.
-            CHECK(first.pairs == brute_force_pairs(frame, row.self));
+            CHECK(first.pairs == test::brute_force_pairs(frame, row.self));
         }
     }
 }
