@@ -20,7 +20,12 @@ class Rng {
     std::uint64_t below(std::uint64_t n) { return next() % n; }
     // Uniform double in [0, 1) with 53 random bits.
     double unit() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
+    // Uniform double in [-1, 1) (exactly 2 unit() - 1).
+    double sym() { return 2.0 * unit() - 1.0; }
     double uniform(double lo, double hi) { return lo + (hi - lo) * unit(); }
+    // Integer in [lo, hi].
+    int range(int lo, int hi) { return lo + static_cast<int>(next() % static_cast<std::uint64_t>(hi - lo + 1)); }
+    bool coin() { return (next() & 1u) != 0; }
     // A value on the grid lo + k / steps_per_unit, k integer, within [lo, hi].
     double grid(double lo, double hi, int steps_per_unit) {
         const auto steps = static_cast<std::uint64_t>((hi - lo) * steps_per_unit);

@@ -15,22 +15,16 @@
 
 #include "../cullide/rational_tri_tri.h"
 #include "cullide/tri_tri.h"
+#include "test_rng.h"
 
 using cullide::TriRelation;
 using cullide::Vec3;
 
 namespace {
 
-struct Rng {  // splitmix64
-    std::uint64_t state;
-    std::uint64_t next() {
-        std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    }
-    double sym() { return static_cast<double>(next() >> 11) * 0x1p-52 - 1.0; }
-    int range(int lo, int hi) { return lo + static_cast<int>(next() % static_cast<std::uint64_t>(hi - lo + 1)); }
+// splitmix64: tests/test_rng.h, plus a vector helper.
+struct Rng : test::Rng {
+    using test::Rng::Rng;
     Vec3 int3(int lo, int hi) {
         const double x = range(lo, hi);
         const double y = range(lo, hi);

@@ -9,22 +9,15 @@
 
 #include "cullide/predicates.h"
 #include "rational_tri_tri.h"
+#include "test_rng.h"
 
 using cullide::Vec3;
 
 namespace {
 
-struct Rng {  // splitmix64
-    std::uint64_t state;
-    std::uint64_t next() {
-        std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    }
-    double unit() { return static_cast<double>(next() >> 11) * 0x1p-53; }
-    double sym() { return 2.0 * unit() - 1.0; }
-    int range(int lo, int hi) { return lo + static_cast<int>(next() % static_cast<std::uint64_t>(hi - lo + 1)); }
+// splitmix64 (Steele, Lea, Flood 2014): tests/test_rng.h, plus vector helpers.
+struct Rng : test::Rng {
+    using test::Rng::Rng;
     Vec3 sym3() {
         const double x = sym();
         const double y = sym();
