@@ -76,10 +76,7 @@ std::vector<ObjectPair> object_pairs(std::span<const TrianglePair> pairs) {
     return out;
 }
 
-Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, const ExactOptions& options,
-                                              ExactStats* stats) {
-    if (Status s = validate_scene(objects); !s) return s.error();
-    if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
+Status validate_exact_range(std::span<const Mesh> objects) {
     // The exact predicates are exact only inside their range (predicates.h): refuse, never guess.
     for (std::size_t i = 0; i < objects.size(); ++i) {
         const Mesh& m = objects[i];
@@ -95,6 +92,14 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
             }
         }
     }
+    return {};
+}
+
+Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, const ExactOptions& options,
+                                              ExactStats* stats) {
+    if (Status s = validate_scene(objects); !s) return s.error();
+    if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
+    if (Status s = validate_exact_range(objects); !s) return s.error();
 
     ExactStats st;
     const std::size_t n = objects.size();

@@ -306,3 +306,28 @@ TEST_CASE("every sub-object size and depth format gives the ground truth in the 
         }
     }
 }
+
+TEST_CASE("every method refuses coordinates outside the exact range, as the ground truth does") {
+    // Regression of fuzz/findings/pipeline: rcullide accepted a subnormal coordinate exact refused.
+    std::vector<cullide::Mesh> objects(2);
+    for (int o = 0; o < 2; ++o) {
+        objects[static_cast<std::size_t>(o)].name = "m" + std::to_string(o);
+        objects[static_cast<std::size_t>(o)].positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+        objects[static_cast<std::size_t>(o)].triangles = {{0, 1, 2}};
+    }
+    // Far from object 0, so the broad phase drops it before any later stage could see it.
+    objects[1].positions = {{10, 0, 0}, {11, 0, 0}, {10, 1, 0}};
+    objects[1].positions[0].y = -0x1p-1073;  // subnormal
+    const auto exact = cullide::exact_pairs(objects);
+    REQUIRE_FALSE(exact.ok());
+    for (Method m : {Method::Exact, Method::Cullide, Method::RCullide, Method::RCullideOffset}) {
+        CAPTURE(cullide::to_string(m));
+        cullide::RunOptions o;
+        o.method = m;
+        o.resolution = 64;
+        o.broadphase = cullide::BroadPhase::SpatialHash;
+        auto r = cullide::process_frame(objects, o);
+        REQUIRE_FALSE(r.ok());
+        CHECK(r.error().message == exact.error().message);
+    }
+}

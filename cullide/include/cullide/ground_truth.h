@@ -52,6 +52,10 @@ struct ExactStats {
                                                             const ExactOptions& options = {},
                                                             ExactStats* stats = nullptr);
 
+// Fails, naming the object, vertex and coordinate, when a coordinate is outside the exact
+// predicates' range. Every method checks it (they all end in the exact test).
+[[nodiscard]] Status validate_exact_range(std::span<const Mesh> objects);
+
 // The object pairs of a sorted triangle-pair list, sorted and unique.
 [[nodiscard]] std::vector<ObjectPair> object_pairs(std::span<const TrianglePair> pairs);
 
