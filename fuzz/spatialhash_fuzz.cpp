@@ -1,7 +1,8 @@
 // libFuzzer target for spatialhash::find_pairs. Property: for any input the three methods agree
 // exactly, on the pairs or on the error message (validation errors are the same for all); the
 // grid's only error of its own, the key-limit guard, must never fire on input that validates.
-// Both boxes and spheres, automatic and given cell sizes, 1-3 threads.
+// Both boxes and spheres, automatic and given cell sizes, 1-3 threads; the grid also through one
+// Workspace reused across all inputs.
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -84,6 +85,16 @@ void check(const std::vector<Shape>& shapes, double cell, unsigned threads) {
     if (!(sap.value().pairs == brute.value().pairs) || !(grid.value().pairs == brute.value().pairs)) {
         std::fprintf(stderr, "pairs differ: brute %zu sap %zu grid %zu\n", brute.value().pairs.size(),
                      sap.value().pairs.size(), grid.value().pairs.size());
+        std::abort();
+    }
+    // The same through one Workspace kept for the whole fuzzing run: whatever earlier inputs left in
+    // its buffers must not change the pairs.
+    static spatialhash::Workspace workspace;
+    static std::vector<spatialhash::Pair> reused;
+    o.cell_size = cell;
+    const auto via_workspace = spatialhash::find_pairs(std::span<const Shape>(shapes), o, workspace, reused);
+    if (!via_workspace.ok() || !(reused == brute.value().pairs)) {
+        std::fprintf(stderr, "workspace pairs differ: %zu vs %zu\n", reused.size(), brute.value().pairs.size());
         std::abort();
     }
 }

@@ -249,20 +249,77 @@ PairSet sweep_and_prune(const Objects& objects, std::span<const Interval> boxes,
     return out;
 }
 
+}  // namespace
+
+namespace detail {
+struct WorkspaceState {
+    GridWorkspace grid;
+    std::unique_ptr<Executor> executor;
+    unsigned executor_threads = 0;
+    Executor& executor_for(unsigned threads) {
+        if (!executor || executor_threads != threads) {
+            executor = std::make_unique<Executor>(threads);
+            executor_threads = threads;
+        }
+        return *executor;
+    }
+};
+struct WorkspaceAccess {
+    static WorkspaceState& state(Workspace& w) {
+        if (!w.state_) w.state_ = std::make_unique<WorkspaceState>();  // a moved-from workspace
+        return *w.state_;
+    }
+};
+}  // namespace detail
+
+Workspace::Workspace() : state_(std::make_unique<detail::WorkspaceState>()) {}
+Workspace::~Workspace() = default;
+Workspace::Workspace(Workspace&&) noexcept = default;
+Workspace& Workspace::operator=(Workspace&&) noexcept = default;
+
+std::size_t Workspace::capacity_bytes() const {
+    if (!state_) return 0;
+    const detail::GridWorkspace& g = state_->grid;
+    const auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+    std::size_t total = bytes(g.bounds) + bytes(g.plan.huge) + bytes(g.plan.huge_ids) + bytes(g.plan_scratch.diameters) +
+                        bytes(g.plan_scratch.sorted) + bytes(g.ids.cell_ids) + bytes(g.ids.objects) +
+                        bytes(g.ids.control) + bytes(g.entry_offsets) + bytes(g.radix.keys) + bytes(g.radix.values) +
+                        bytes(g.radix.hist) + bytes(g.radix_pairs.keys) + bytes(g.radix_pairs.values) + bytes(g.radix_pairs.hist) + bytes(g.cells.cells) + bytes(g.cell_starts) + bytes(g.filter) +
+                        bytes(g.collide.items) + bytes(g.collide.item_counts) + bytes(g.collide.offsets) +
+                        bytes(g.pair_keys);
+    for (const auto& per_item : g.collide.found) {
+        for (const auto& v : per_item) total += bytes(v);
+    }
+    return total;
+}
+
+namespace {
+
 template <class Shape>
-Result<PairSet> run(std::span<const Shape> shapes, const Options& options) {
-    if (Result<bool> v = validate_common(shapes.size(), options); !v) return v.error();
-    if (Result<bool> v = validate(shapes); !v) return v.error();
-    Executor ex(options.threads);
+Result<Stats> run_into(std::span<const Shape> shapes, const Options& options, detail::WorkspaceState& ws,
+                       std::vector<Pair>& pairs) {
+    // (No pairs.clear() up front: the grid resizes `pairs` and overwrites every element, so a warm
+    // vector is not zero-filled again each frame.)
+    if (Result<bool> v = validate_common(shapes.size(), options); !v) {
+        pairs.clear();
+        return v.error();
+    }
+    if (Result<bool> v = validate(shapes); !v) {
+        pairs.clear();
+        return v.error();
+    }
+    Executor& ex = ws.executor_for(options.threads);
     Objects objects;
     if constexpr (std::is_same_v<Shape, Box>) {
         objects.boxes = shapes;
     } else {
         objects.spheres = shapes;
     }
+    PairSet other;
     switch (options.method) {
         case Method::BruteForce:
-            return brute_force(objects, ex);
+            other = brute_force(objects, ex);
+            break;
         case Method::SweepAndPrune: {
             std::vector<Interval> intervals(shapes.size());
             if constexpr (std::is_same_v<Shape, Box>) {
@@ -279,14 +336,40 @@ Result<PairSet> run(std::span<const Shape> shapes, const Options& options) {
                     }
                 }
             }
-            return sweep_and_prune(objects, intervals, ex);
+            other = sweep_and_prune(objects, intervals, ex);
+            break;
         }
         case Method::SpatialHash: {
-            const std::vector<detail::BoundingSphere> bs = detail::bounding_spheres(shapes, ex);
-            return detail::grid_find_pairs(objects, bs, options.cell_size, ex);
+            Result<Stats> r = [&]() -> Result<Stats> {
+                if constexpr (std::is_same_v<Shape, Box>) {
+                    // Boxes through their bounding cubes (smaller cells than the circumscribed
+                    // sphere's; docs/spatialhash.md, "Sizing: boxes").
+                    detail::bounding_cubes(shapes, ex, ws.grid.bounds);
+                    return detail::grid_find_pairs(objects, options.cell_size, ex, detail::kCubeKnobs, ws.grid, pairs);
+                } else {
+                    detail::bounding_spheres(shapes, ex, ws.grid.bounds);
+                    return detail::grid_find_pairs(objects, options.cell_size, ex, detail::PlanKnobs{}, ws.grid, pairs);
+                }
+            }();
+            if (!r) pairs.clear();
+            return r;
         }
+        default:
+            pairs.clear();
+            return Error{"unknown Method " + std::to_string(static_cast<int>(options.method))};
     }
-    return Error{"unknown Method " + std::to_string(static_cast<int>(options.method))};
+    pairs.swap(other.pairs);
+    return other.stats;
+}
+
+template <class Shape>
+Result<PairSet> run(std::span<const Shape> shapes, const Options& options) {
+    detail::WorkspaceState ws;
+    PairSet out;
+    Result<Stats> stats = run_into(shapes, options, ws, out.pairs);
+    if (!stats) return stats.error();
+    out.stats = stats.value();
+    return out;
 }
 
 }  // namespace
@@ -294,5 +377,15 @@ Result<PairSet> run(std::span<const Shape> shapes, const Options& options) {
 Result<PairSet> find_pairs(std::span<const Box> boxes, const Options& options) { return run(boxes, options); }
 
 Result<PairSet> find_pairs(std::span<const Sphere> spheres, const Options& options) { return run(spheres, options); }
+
+Result<Stats> find_pairs(std::span<const Box> boxes, const Options& options, Workspace& workspace,
+                         std::vector<Pair>& pairs) {
+    return run_into(boxes, options, detail::WorkspaceAccess::state(workspace), pairs);
+}
+
+Result<Stats> find_pairs(std::span<const Sphere> spheres, const Options& options, Workspace& workspace,
+                         std::vector<Pair>& pairs) {
+    return run_into(spheres, options, detail::WorkspaceAccess::state(workspace), pairs);
+}
 
 }  // namespace spatialhash

@@ -41,7 +41,20 @@ double half_diagonal(const double e[3]) {
 }
 
 // The "count -> scan -> fill" pattern over fixed items: count(i) returns item i's output size,
-// fill(i, out) writes exactly that many elements starting at out.
+// fill(i, out) writes exactly that many elements starting at out. This one writes into a caller's
+// vector (its capacity is kept; the small offsets array is per call); count_scan_fill returns a new one.
+template <class T, class Count, class Fill>
+void count_scan_fill_into(std::vector<T>& out, std::size_t items, Executor& ex, Count&& count, Fill&& fill) {
+    std::vector<std::size_t> offsets(items + 1, 0);
+    ex.for_each(items, [&](std::size_t i) { offsets[i + 1] = count(i); });
+    for (std::size_t i = 0; i < items; ++i) offsets[i + 1] += offsets[i];
+    out.resize(offsets[items]);
+    ex.for_each(items, [&](std::size_t i) {
+        [[maybe_unused]] const std::size_t written = fill(i, out.data() + offsets[i]);
+        assert(written == offsets[i + 1] - offsets[i]);
+    });
+}
+
 template <class T, class Count, class Fill>
 std::vector<T> count_scan_fill(std::size_t items, Executor& ex, Count&& count, Fill&& fill) {
     std::vector<std::size_t> offsets(items + 1, 0);
@@ -102,8 +115,39 @@ std::vector<BoundingSphere> bounding_spheres(std::span<const Box> boxes, Executo
     return out;
 }
 
+std::vector<BoundingSphere> bounding_cubes(std::span<const Box> boxes, Executor& ex) {
+    std::vector<BoundingSphere> out;
+    bounding_cubes(boxes, ex, out);
+    return out;
+}
+
+void bounding_cubes(std::span<const Box> boxes, Executor& ex, std::vector<BoundingSphere>& out) {
+    out.resize(boxes.size());
+    ex.for_each(chunk_count(boxes.size()), [&](std::size_t c) {
+        const std::size_t end = std::min(boxes.size(), (c + 1) * kChunk);
+        for (std::size_t i = c * kChunk; i < end; ++i) {
+            const Box& b = boxes[i];
+            BoundingSphere& s = out[i];
+            double e = 0.0;
+            for (int k = 0; k < 3; ++k) {
+                s.centre[k] = 0.5 * b.lo[k] + 0.5 * b.hi[k];
+                // 0.5 hi - 0.5 lo cannot overflow; halving is exact except deep in the subnormals,
+                // which the absolute padding term covers.
+                e = std::max(e, 0.5 * b.hi[k] - 0.5 * b.lo[k]);
+            }
+            s.radius = padded_radius(e, s.centre);
+        }
+    });
+}
+
 std::vector<BoundingSphere> bounding_spheres(std::span<const Sphere> spheres, Executor& ex) {
-    std::vector<BoundingSphere> out(spheres.size());
+    std::vector<BoundingSphere> out;
+    bounding_spheres(spheres, ex, out);
+    return out;
+}
+
+void bounding_spheres(std::span<const Sphere> spheres, Executor& ex, std::vector<BoundingSphere>& out) {
+    out.resize(spheres.size());
     ex.for_each(chunk_count(spheres.size()), [&](std::size_t c) {
         const std::size_t end = std::min(spheres.size(), (c + 1) * kChunk);
         for (std::size_t i = c * kChunk; i < end; ++i) {
@@ -112,13 +156,20 @@ std::vector<BoundingSphere> bounding_spheres(std::span<const Sphere> spheres, Ex
             s.radius = padded_radius(spheres[i].radius, s.centre);
         }
     });
-    return out;
 }
 
 Result<GridPlan> plan_grid(std::span<const BoundingSphere> spheres, double requested_cell_size, Executor& ex,
                            const PlanKnobs& knobs) {
-    const std::size_t n = spheres.size();
     GridPlan plan;
+    PlanScratch scratch;
+    if (Result<bool> r = plan_grid(spheres, requested_cell_size, ex, knobs, plan, scratch); !r) return r.error();
+    return plan;
+}
+
+Result<bool> plan_grid(std::span<const BoundingSphere> spheres, double requested_cell_size, Executor& ex,
+                       const PlanKnobs& knobs, GridPlan& plan, PlanScratch& scratch) {
+    const std::size_t n = spheres.size();
+    plan.huge_ids.clear();
     plan.coverage_scale = knobs.coverage_scale;
     // Below 1 a coverage box could span three cells per axis, more than the 2^d slots.
     const double min_cell_factor = std::max(1.0, knobs.min_cell_factor);
@@ -132,11 +183,14 @@ Result<GridPlan> plan_grid(std::span<const BoundingSphere> spheres, double reque
                 !(min_cell_factor * scaled_diameter(i) <= cell) || !coverage_finite(spheres[i], knobs.coverage_scale) ? 1 : 0;
         }
     } else if (n > 0) {
-        // Automatic: the chapter's rule (1.5 x the largest scaled sphere) over every object except
+        // Automatic: the chapter's rule (knobs.auto_cell_factor x the largest scaled diameter: 1.5
+        // for spheres as in the chapter, 1.1 for cubes, docs/spatialhash.md) over every object except
         // outliers above kOutlierFactor x the 99th percentile, which are tested apart.
-        std::vector<double> d(n);
+        std::vector<double>& d = scratch.diameters;
+        d.resize(n);
         for (std::size_t i = 0; i < n; ++i) d[i] = scaled_diameter(i);
-        std::vector<double> sorted = d;
+        std::vector<double>& sorted = scratch.sorted;
+        sorted.assign(d.begin(), d.end());
         const auto rank = static_cast<std::size_t>(kOutlierQuantile * static_cast<double>(n - 1));
         std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(rank), sorted.end());
         const double q = sorted[rank];
@@ -147,7 +201,7 @@ Result<GridPlan> plan_grid(std::span<const BoundingSphere> spheres, double reque
             plan.huge[i] = huge ? 1 : 0;
             if (!huge) largest = std::max(largest, d[i]);
         }
-        cell = std::max(kAutoCellFactor, min_cell_factor) * largest;
+        cell = std::max(knobs.auto_cell_factor, min_cell_factor) * largest;
         if (!(cell > 0.0)) {
             // Only points in the grid: any cell works; take 1/1024 of the scene's extent.
             double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
@@ -227,7 +281,7 @@ Result<GridPlan> plan_grid(std::span<const BoundingSphere> spheres, double reque
     plan.axis_bits = std::clamp(static_cast<unsigned>(std::bit_width(max_coord)), 1U, kMaxAxisBits);
     plan.sentinel = std::uint64_t{1} << (3 * plan.axis_bits);
     plan.key_bits = 3 * plan.axis_bits + 1;
-    return plan;
+    return true;
 }
 
 namespace {
@@ -309,10 +363,18 @@ CellIdArray build_cell_ids(std::span<const BoundingSphere> spheres, const GridPl
 }
 
 CellIdArray build_cell_entries(std::span<const BoundingSphere> spheres, const GridPlan& plan, Executor& ex) {
+    CellIdArray out;
+    std::vector<std::size_t> offset;
+    build_cell_entries(spheres, plan, ex, out, offset);
+    return out;
+}
+
+void build_cell_entries(std::span<const BoundingSphere> spheres, const GridPlan& plan, Executor& ex, CellIdArray& out,
+                        std::vector<std::size_t>& offset) {
     const std::size_t n = spheres.size();
     const std::size_t chunks = chunk_count(n);
     // Count: entries per (chunk, slot). An object fills slots [0, cells).
-    std::vector<std::size_t> offset(chunks * kSlots, 0);
+    offset.assign(chunks * kSlots, 0);
     ex.for_each(chunks, [&](std::size_t c) {
         std::size_t* cnt = offset.data() + c * kSlots;
         const std::size_t end = std::min(n, (c + 1) * kChunk);
@@ -332,7 +394,6 @@ CellIdArray build_cell_entries(std::span<const BoundingSphere> spheres, const Gr
             running += k;
         }
     }
-    CellIdArray out;
     out.cell_ids.resize(running);
     out.objects.resize(running);
     out.control.assign(n, 0);
@@ -352,7 +413,6 @@ CellIdArray build_cell_entries(std::span<const BoundingSphere> spheres, const Gr
             }
         }
     });
-    return out;
 }
 
 void drop_sentinels(CellIdArray& ids, const GridPlan& plan, Executor& ex) {
@@ -386,6 +446,13 @@ CollisionCells build_collision_cells(std::span<const std::uint64_t> sorted_keys,
                                      std::span<const std::uint32_t> sorted_objects, const GridPlan& plan,
                                      Executor& ex) {
     CollisionCells out;
+    std::vector<std::uint32_t> starts;
+    build_collision_cells(sorted_keys, sorted_objects, plan, ex, out, starts);
+    return out;
+}
+
+void build_collision_cells(std::span<const std::uint64_t> sorted_keys, std::span<const std::uint32_t> sorted_objects,
+                           const GridPlan& plan, Executor& ex, CollisionCells& out, std::vector<std::uint32_t>& starts) {
     // Sentinels sort last: the real entries are the prefix below the first sentinel.
     const auto valid = static_cast<std::size_t>(
         std::lower_bound(sorted_keys.begin(), sorted_keys.end(), plan.sentinel) - sorted_keys.begin());
@@ -393,8 +460,8 @@ CollisionCells build_collision_cells(std::span<const std::uint64_t> sorted_keys,
     // Scan 1: where the key changes (cell starts).
     const std::size_t chunks = chunk_count(valid);
     const auto is_start = [&](std::size_t i) { return i == 0 || sorted_keys[i] != sorted_keys[i - 1]; };
-    const std::vector<std::uint32_t> starts = count_scan_fill<std::uint32_t>(
-        chunks, ex,
+    count_scan_fill_into<std::uint32_t>(
+        starts, chunks, ex,
         [&](std::size_t c) {
             std::size_t k = 0;
             const std::size_t end = std::min(valid, (c + 1) * kChunk);
@@ -421,8 +488,8 @@ CollisionCells build_collision_cells(std::span<const std::uint64_t> sorted_keys,
     };
     const auto keep = [](const CollisionCell& cc) { return cc.homes >= 1 && cc.homes + cc.phantoms >= 2; };
     constexpr std::size_t kCellChunk = 4096;
-    out.cells = count_scan_fill<CollisionCell>(
-        chunk_count(cells, kCellChunk), ex,
+    count_scan_fill_into<CollisionCell>(
+        out.cells, chunk_count(cells, kCellChunk), ex,
         [&](std::size_t c) {
             std::size_t k = 0;
             const std::size_t end = std::min(cells, (c + 1) * kCellChunk);
@@ -438,7 +505,6 @@ CollisionCells build_collision_cells(std::span<const std::uint64_t> sorted_keys,
             }
             return k;
         });
-    return out;
 }
 
 namespace {
@@ -508,22 +574,24 @@ struct CellScratch {
     }
 };
 
-// Whether any of the 8 entries [m, m + 8) may pass the float pre-test against box a. Most blocks
-// have no hit (a cell proposes ~60 pairs per overlap in the chapter's sizing), so this answers
-// "none" with a few SIMD compares. GCC and clang vector extensions: SSE/NEON where the target has
-// them, plain code otherwise; other compilers take the scalar loop. Either way it only skips work.
+// The outer float pre-test of the 8 entries [m, m + 8) against box a, as a bit mask. Most blocks
+// have no hit, so this answers "none" with a few SIMD compares, and in the dense blocks of
+// clustered scenes it hands over the mask without a second, scalar pass (performance log, idea 14).
+// GCC and clang vector extensions: SSE/NEON where the target has them, plain code otherwise; other
+// compilers take the scalar loop. Both compute the same IEEE comparisons.
 #if defined(__GNUC__)
 // 4 floats (16 bytes): SSE/NEON width. Vectors are only locals here, never passed or returned, so
 // no vector ABI question arises on targets without SIMD.
 typedef float Quad __attribute__((vector_size(16)));
 typedef std::int32_t QuadMask __attribute__((vector_size(16)));
 #endif
-inline bool lanes_may_hit(std::uint32_t m, const float* lx, const float* ly, const float* lz, const float* hx,
-                          const float* hy, const float* hz, float alx, float aly, float alz, float ahx, float ahy,
-                          float ahz) {
+// Returns the hit mask of the 8 entries (bit j = entry m + j passes the outer float test).
+inline unsigned lanes_hits(std::uint32_t m, const float* lx, const float* ly, const float* lz, const float* hx,
+                           const float* hy, const float* hz, float alx, float aly, float alz, float ahx, float ahy,
+                           float ahz) {
 #if defined(__GNUC__)
-    QuadMask any = {0, 0, 0, 0};
-    for (std::uint32_t e = m; e < m + kLanes; e += 4) {
+    unsigned bits = 0;
+    for (std::uint32_t e = m, shift = 0; e < m + kLanes; e += 4, shift += 4) {
         Quad v[6];
         std::memcpy(&v[0], lx + e, sizeof(Quad));
         std::memcpy(&v[1], hx + e, sizeof(Quad));
@@ -531,25 +599,37 @@ inline bool lanes_may_hit(std::uint32_t m, const float* lx, const float* ly, con
         std::memcpy(&v[3], hy + e, sizeof(Quad));
         std::memcpy(&v[4], lz + e, sizeof(Quad));
         std::memcpy(&v[5], hz + e, sizeof(Quad));
-        any |= (v[0] <= ahx) & (alx <= v[1]) & (v[2] <= ahy) & (aly <= v[3]) & (v[4] <= ahz) & (alz <= v[5]);
+        const QuadMask hit =
+            (v[0] <= ahx) & (alx <= v[1]) & (v[2] <= ahy) & (aly <= v[3]) & (v[4] <= ahz) & (alz <= v[5]);
+        // Lanes are all-ones or zero: keep one distinct bit per lane and fold them.
+        const QuadMask lane_bit = {1, 2, 4, 8};
+        const QuadMask b = hit & lane_bit;
+        bits |= static_cast<unsigned>(b[0] | b[1] | b[2] | b[3]) << shift;
     }
-    std::uint64_t words[2];
-    std::memcpy(words, &any, sizeof words);
-    return (words[0] | words[1]) != 0;
+    return bits;
 #else
-    bool any = false;
-    for (std::uint32_t e = m; e < m + kLanes; ++e) {
-        any |= (lx[e] <= ahx) & (alx <= hx[e]) & (ly[e] <= ahy) & (aly <= hy[e]) & (lz[e] <= ahz) & (alz <= hz[e]);
+    unsigned bits = 0;
+    for (std::uint32_t j = 0; j < kLanes; ++j) {
+        const std::uint32_t e = m + j;
+        const bool hit = (lx[e] <= ahx) & (alx <= hx[e]) & (ly[e] <= ahy) & (aly <= hy[e]) & (lz[e] <= ahz) & (alz <= hz[e]);
+        bits |= static_cast<unsigned>(hit) << j;
     }
-    return any;
+    return bits;
 #endif
 }
 
 }  // namespace
 
 std::vector<FilterBox> filter_boxes(const Objects& objects, std::span<const BoundingSphere> spheres, Executor& ex) {
+    std::vector<FilterBox> out;
+    filter_boxes(objects, spheres, ex, out);
+    return out;
+}
+
+void filter_boxes(const Objects& objects, std::span<const BoundingSphere> spheres, Executor& ex,
+                  std::vector<FilterBox>& out) {
     const std::size_t n = objects.size();
-    std::vector<FilterBox> out(n);
+    out.resize(n);
     ex.for_each(chunk_count(n), [&](std::size_t c) {
         const std::size_t end = std::min(n, (c + 1) * kChunk);
         for (std::size_t i = c * kChunk; i < end; ++i) {
@@ -569,12 +649,22 @@ std::vector<FilterBox> filter_boxes(const Objects& objects, std::span<const Boun
             }
         }
     });
-    return out;
 }
 
 std::vector<Pair> collide_cells(const CollisionCells& cells, std::span<const std::uint32_t> sorted_objects,
                                 std::span<const std::uint16_t> control, const Objects& objects,
                                 std::span<const FilterBox> filter, Executor& ex, CollideCounts* counts) {
+    std::vector<Pair> out;
+    CollideScratch scratch;
+    const CollideCounts c = collide_cells(cells, sorted_objects, control, objects, filter, ex, out, scratch);
+    if (counts) *counts = c;
+    return out;
+}
+
+CollideCounts collide_cells(const CollisionCells& cells, std::span<const std::uint32_t> sorted_objects,
+                            std::span<const std::uint16_t> control, const Objects& objects,
+                            std::span<const FilterBox> filter, Executor& ex, std::vector<Pair>& all,
+                            CollideScratch& scratch) {
     // Visits the pairs of one cell in pass t, in the chapter's order (each H entry against every
     // later entry); emit(a, b) gets a < b. The outer float test runs 8 entries at a time without
     // branches; only its survivors meet the duplicate-avoidance rule, then the inner float test,
@@ -595,14 +685,8 @@ std::vector<Pair> collide_cells(const CollisionCells& cells, std::span<const std
             const std::uint16_t ca = sc.control[h];
             const float alx = lx[h], aly = ly[h], alz = lz[h], ahx = hx[h], ahy = hy[h], ahz = hz[h];
             for (std::uint32_t m = h + 1; m < size; m += kLanes) {
-                if (!lanes_may_hit(m, lx, ly, lz, hx, hy, hz, alx, aly, alz, ahx, ahy, ahz)) continue;
-                unsigned bits = 0;
-                for (std::uint32_t j = 0; j < kLanes; ++j) {
-                    const std::uint32_t e = m + j;
-                    const bool hit = (lx[e] <= ahx) & (alx <= hx[e]) & (ly[e] <= ahy) & (aly <= hy[e]) &
-                                     (lz[e] <= ahz) & (alz <= hz[e]);
-                    bits |= static_cast<unsigned>(hit) << j;
-                }
+                unsigned bits = lanes_hits(m, lx, ly, lz, hx, hy, hz, alx, aly, alz, ahx, ahy, ahz);
+                if (bits == 0) continue;
                 if (size - m < kLanes) bits &= (1U << (size - m)) - 1U;  // padding lanes
                 while (bits != 0) {
                     const std::uint32_t e = m + static_cast<std::uint32_t>(std::countr_zero(bits));
@@ -627,11 +711,8 @@ std::vector<Pair> collide_cells(const CollisionCells& cells, std::span<const std
     // key order means neighbouring cells, which share objects, are visited close together in time:
     // the objects' filter boxes are still in cache (at 1M objects this halved the stage).
     constexpr std::uint64_t kItemWork = std::uint64_t{1} << 15;
-    struct Item {
-        std::uint32_t begin;  // into cells.cells
-        std::uint32_t end;
-    };
-    std::vector<Item> items;
+    std::vector<CollideScratch::Item>& items = scratch.items;
+    items.clear();
     {
         std::uint64_t work = 0;
         std::uint32_t begin = 0;
@@ -640,7 +721,7 @@ std::vector<Pair> collide_cells(const CollisionCells& cells, std::span<const std
             const CollisionCell& cc = cells.cells[j];
             work += static_cast<std::uint64_t>(cc.homes) * (cc.homes + cc.phantoms) + 16;
             if (work >= kItemWork || j + 1 == count) {
-                items.push_back(Item{begin, j + 1});
+                items.push_back(CollideScratch::Item{begin, j + 1});
                 begin = j + 1;
                 work = 0;
             }
@@ -648,10 +729,16 @@ std::vector<Pair> collide_cells(const CollisionCells& cells, std::span<const std
     }
     // One visit per cell: each item collects its pairs in its own buffers (the "count"), the sizes
     // are scanned into offsets and the buffers copied into place (the "fill").
-    std::vector<std::array<std::vector<Pair>, kSlots>> found(items.size());
-    std::vector<CollideCounts> item_counts(items.size());
+    // The buffers keep their capacity from frame to frame (a Workspace's scratch); clearing them
+    // does not free.
+    std::vector<std::array<std::vector<Pair>, kSlots>>& found = scratch.found;
+    if (found.size() < items.size()) found.resize(items.size());
+    std::vector<CollideCounts>& item_counts = scratch.item_counts;
+    item_counts.assign(items.size(), CollideCounts{});
     ex.for_each(items.size(), [&](std::size_t c) {
-        CellScratch sc;
+        for (std::vector<Pair>& v : found[c]) v.clear();
+        // Gather arrays per thread, kept between calls (their contents never reach the output).
+        thread_local CellScratch sc;
         for (std::uint32_t j = items[c].begin; j < items[c].end; ++j) {
             const CollisionCell& cc = cells.cells[j];
             std::vector<Pair>& out = found[c][cc.type];
@@ -659,14 +746,15 @@ std::vector<Pair> collide_cells(const CollisionCells& cells, std::span<const std
         }
     });
     // offsets[t * items + c]: where type t's pairs of item c go.
-    std::vector<std::size_t> offsets(kSlots * items.size() + 1, 0);
+    std::vector<std::size_t>& offsets = scratch.offsets;
+    offsets.assign(kSlots * items.size() + 1, 0);
     for (std::size_t t = 0; t < kSlots; ++t) {
         for (std::size_t c = 0; c < items.size(); ++c) {
             const std::size_t slot = t * items.size() + c;
             offsets[slot + 1] = offsets[slot] + found[c][t].size();
         }
     }
-    std::vector<Pair> all(offsets.back());
+    all.resize(offsets.back());
     ex.for_each(items.size(), [&](std::size_t c) {
         for (std::size_t t = 0; t < kSlots; ++t) {
             std::copy(found[c][t].begin(), found[c][t].end(),
@@ -678,8 +766,7 @@ std::vector<Pair> collide_cells(const CollisionCells& cells, std::span<const std
         total.cell_pairs += v.cell_pairs;
         total.exact_tests += v.exact_tests;
     }
-    if (counts) *counts = total;
-    return all;
+    return total;
 }
 
 std::vector<Pair> collide_huge(std::span<const std::uint32_t> huge_ids, std::span<const std::uint8_t> huge,
@@ -722,16 +809,54 @@ std::vector<Pair> collide_huge(std::span<const std::uint32_t> huge_ids, std::spa
 }
 
 void sort_pairs(std::vector<Pair>& pairs, std::size_t object_count, Executor& ex) {
-    std::vector<std::uint64_t> keys(pairs.size());
-    ex.for_each(chunk_count(pairs.size()), [&](std::size_t c) {
-        const std::size_t end = std::min(pairs.size(), (c + 1) * kChunk);
+    std::vector<std::uint64_t> keys;
+    RadixScratch scratch;
+    sort_pairs(pairs, object_count, ex, keys, scratch);
+}
+
+void sort_pairs(std::vector<Pair>& pairs, std::size_t object_count, Executor& ex, std::vector<std::uint64_t>& keys,
+                RadixScratch& scratch) {
+    const std::size_t m = pairs.size();
+    keys.resize(m);
+    ex.for_each(chunk_count(m), [&](std::size_t c) {
+        const std::size_t end = std::min(m, (c + 1) * kChunk);
         for (std::size_t i = c * kChunk; i < end; ++i) keys[i] = (std::uint64_t{pairs[i].a} << 32) | pairs[i].b;
     });
+    // Radix-sort on a only (the bits in use: bit_width(n - 1), 2 passes up to 2^22 objects), then
+    // sort each run of equal a by b. A run holds one object's partners, a handful in the benchmark's
+    // scenes, so the second step is an insertion sort in cache; long runs (a huge object's) take
+    // std::sort. Keys are unique, so the result is the one sorted order whatever the chunking.
+    const auto top = static_cast<unsigned>(std::bit_width(std::max<std::size_t>(object_count, 2) - 1));
     std::vector<std::uint32_t> no_values;
-    const auto top = static_cast<unsigned>(std::bit_width(std::max<std::size_t>(object_count, 1)));
-    radix_sort(keys, no_values, 32 + top, ex);
-    ex.for_each(chunk_count(pairs.size()), [&](std::size_t c) {
-        const std::size_t end = std::min(pairs.size(), (c + 1) * kChunk);
+    radix_sort_bits(keys, no_values, 32, 32 + top, ex, scratch);
+    const auto a_of = [&](std::size_t i) { return keys[i] >> 32; };
+    // Each chunk sorts the runs that start in it (a run may reach into the next chunks).
+    ex.for_each(chunk_count(m), [&](std::size_t c) {
+        const std::size_t end = std::min(m, (c + 1) * kChunk);
+        std::size_t i = c * kChunk;
+        if (i > 0) {
+            while (i < end && a_of(i) == a_of(i - 1)) ++i;  // the previous chunk's run
+        }
+        while (i < end) {
+            std::size_t j = i + 1;
+            while (j < m && a_of(j) == a_of(i)) ++j;
+            std::uint64_t* run = keys.data() + i;
+            const std::size_t len = j - i;
+            if (len <= 32) {
+                for (std::size_t x = 1; x < len; ++x) {
+                    const std::uint64_t v = run[x];
+                    std::size_t y = x;
+                    for (; y > 0 && run[y - 1] > v; --y) run[y] = run[y - 1];
+                    run[y] = v;
+                }
+            } else {
+                std::sort(run, run + len);
+            }
+            i = j;
+        }
+    });
+    ex.for_each(chunk_count(m), [&](std::size_t c) {
+        const std::size_t end = std::min(m, (c + 1) * kChunk);
         for (std::size_t i = c * kChunk; i < end; ++i) {
             pairs[i] = Pair{static_cast<std::uint32_t>(keys[i] >> 32), static_cast<std::uint32_t>(keys[i])};
         }
@@ -740,30 +865,44 @@ void sort_pairs(std::vector<Pair>& pairs, std::size_t object_count, Executor& ex
 
 Result<PairSet> grid_find_pairs(const Objects& objects, std::span<const BoundingSphere> spheres,
                                 double requested_cell_size, Executor& ex, const PlanKnobs& knobs) {
-    Result<GridPlan> planned = plan_grid(spheres, requested_cell_size, ex, knobs);
-    if (!planned) return planned.error();
-    const GridPlan& plan = planned.value();
-    CellIdArray ids = build_cell_entries(spheres, plan, ex);
-    radix_sort(ids.cell_ids, ids.objects, plan.key_bits - 1, ex);
-    const CollisionCells cells = build_collision_cells(ids.cell_ids, ids.objects, plan, ex);
+    GridWorkspace ws;
+    ws.bounds.assign(spheres.begin(), spheres.end());
     PairSet out;
-    CollideCounts grid_counts;
-    std::uint64_t huge_tests = 0;
-    const std::vector<FilterBox> filter = filter_boxes(objects, spheres, ex);
-    out.pairs = collide_cells(cells, ids.objects, ids.control, objects, filter, ex, &grid_counts);
-    if (!plan.huge_ids.empty()) {
-        std::vector<Pair> extra = collide_huge(plan.huge_ids, plan.huge, objects, ex, &huge_tests);
-        out.pairs.insert(out.pairs.end(), extra.begin(), extra.end());
-    }
-    sort_pairs(out.pairs, objects.size(), ex);
-    out.stats.cell_size = plan.cell_size;
-    out.stats.axis_bits = plan.axis_bits;
-    out.stats.huge_objects = static_cast<std::uint32_t>(plan.huge_ids.size());
-    out.stats.cell_entries = cells.entries;
-    out.stats.collision_cells = cells.cells.size();
-    out.stats.cell_pairs = grid_counts.cell_pairs;
-    out.stats.candidate_tests = grid_counts.exact_tests + huge_tests;
+    Result<Stats> stats = grid_find_pairs(objects, requested_cell_size, ex, knobs, ws, out.pairs);
+    if (!stats) return stats.error();
+    out.stats = stats.value();
     return out;
+}
+
+Result<Stats> grid_find_pairs(const Objects& objects, double requested_cell_size, Executor& ex, const PlanKnobs& knobs,
+                              GridWorkspace& ws, std::vector<Pair>& pairs) {
+    const std::span<const BoundingSphere> spheres = ws.bounds;
+    if (Result<bool> r = plan_grid(spheres, requested_cell_size, ex, knobs, ws.plan, ws.plan_scratch); !r) {
+        return r.error();
+    }
+    const GridPlan& plan = ws.plan;
+    build_cell_entries(spheres, plan, ex, ws.ids, ws.entry_offsets);
+    radix_sort_bits(ws.ids.cell_ids, ws.ids.objects, 0, plan.key_bits - 1, ex, ws.radix);
+    build_collision_cells(ws.ids.cell_ids, ws.ids.objects, plan, ex, ws.cells, ws.cell_starts);
+    std::uint64_t huge_tests = 0;
+    filter_boxes(objects, spheres, ex, ws.filter);
+    const CollideCounts grid_counts =
+        collide_cells(ws.cells, ws.ids.objects, ws.ids.control, objects, ws.filter, ex, pairs, ws.collide);
+    if (!plan.huge_ids.empty()) {
+        // (Allocates: only scenes with outliers take this path.)
+        std::vector<Pair> extra = collide_huge(plan.huge_ids, plan.huge, objects, ex, &huge_tests);
+        pairs.insert(pairs.end(), extra.begin(), extra.end());
+    }
+    sort_pairs(pairs, objects.size(), ex, ws.pair_keys, ws.radix_pairs);
+    Stats stats;
+    stats.cell_size = plan.cell_size;
+    stats.axis_bits = plan.axis_bits;
+    stats.huge_objects = static_cast<std::uint32_t>(plan.huge_ids.size());
+    stats.cell_entries = ws.cells.entries;
+    stats.collision_cells = ws.cells.cells.size();
+    stats.cell_pairs = grid_counts.cell_pairs;
+    stats.candidate_tests = grid_counts.exact_tests + huge_tests;
+    return stats;
 }
 
 }  // namespace spatialhash::detail

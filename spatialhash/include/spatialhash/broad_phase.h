@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -83,6 +84,39 @@ Result<PairSet> find_pairs(std::span<const Box> boxes, const Options& options = 
 // All overlapping pairs among `spheres`, same contract. Fails, naming the index, on a non-finite
 // or out-of-range centre or radius (see Sphere).
 Result<PairSet> find_pairs(std::span<const Sphere> spheres, const Options& options = {});
+
+// Reusable buffers for repeated calls (one per simulation, frame after frame). A frame through a
+// Workspace allocates nothing proportional to n or to the pairs once an earlier frame was at least
+// as large (SpatialHash; the other methods and the huge-object path still allocate), and keeps the
+// thread arena. The result is the same as find_pairs without a workspace, for any scene: the
+// buffers' contents never reach the output. Not for two threads at once; movable, not copyable
+// (a moved-from workspace starts afresh on its next use).
+namespace detail {
+struct WorkspaceState;
+struct WorkspaceAccess;
+}
+class Workspace {
+   public:
+    Workspace();
+    ~Workspace();
+    Workspace(Workspace&&) noexcept;
+    Workspace& operator=(Workspace&&) noexcept;
+    Workspace(const Workspace&) = delete;
+    Workspace& operator=(const Workspace&) = delete;
+    // Bytes of capacity held (for reports).
+    [[nodiscard]] std::size_t capacity_bytes() const;
+
+   private:
+    friend struct detail::WorkspaceAccess;
+    std::unique_ptr<detail::WorkspaceState> state_;
+};
+
+// As find_pairs above, through `workspace`, into `pairs` (its capacity is reused; its old content is
+// replaced). Returns the statistics; on an error `pairs` is left empty.
+Result<Stats> find_pairs(std::span<const Box> boxes, const Options& options, Workspace& workspace,
+                         std::vector<Pair>& pairs);
+Result<Stats> find_pairs(std::span<const Sphere> spheres, const Options& options, Workspace& workspace,
+                         std::vector<Pair>& pairs);
 
 // The exact overlap predicates every method uses (exposed so that callers and tests share them).
 [[nodiscard]] bool overlaps(const Box& x, const Box& y);

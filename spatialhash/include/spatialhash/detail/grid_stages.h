@@ -3,7 +3,8 @@
 // Detection with CUDA", 2007); the CPU port, the key layout and the outlier handling are ours.
 // docs/spatialhash.md explains every stage and why it is correct.
 //
-//   plan_grid            bounding spheres -> cell size, origin, key layout, huge (outlier) objects
+//   bounding_spheres / bounding_cubes   per-object bounding volume (spheres; boxes use cubes)
+//   plan_grid            bounding volumes -> cell size, origin, key layout, huge (outlier) objects
 //   build_cell_ids       cell-ID array: 8 slots per object (home first, phantoms, sentinels),
 //                        object array (id << 1 | phantom bit), control bits per object
 //   build_cell_entries   the same entries without sentinels, straight into compact arrays (CPU
@@ -15,6 +16,8 @@
 //                        one visit per cell into per-item buffers -> scan -> copy
 //   collide_huge         huge objects against every object; count -> scan -> fill
 //   sort_pairs           the final canonical order
+// Each stage also has a form that writes into caller-kept arrays (GridWorkspace, behind
+// spatialhash::Workspace); the by-value forms call those with fresh arrays.
 #pragma once
 
 #include <array>
@@ -54,6 +57,7 @@ inline constexpr unsigned kMaxAxisBits = 21;
 
 // A conservative bounding sphere: the object lies inside it even after rounding (the radius is
 // padded by 2^-46 x (radius + max |centre[k]|), see docs/spatialhash.md).
+// For box input through bounding_cubes the same struct holds a bounding cube (max-norm ball).
 struct BoundingSphere {
     double centre[3];
     double radius;
@@ -63,6 +67,12 @@ struct BoundingSphere {
 // (the sphere, padded). Inputs must be valid (find_pairs validates them first).
 [[nodiscard]] std::vector<BoundingSphere> bounding_spheres(std::span<const Box> boxes, Executor& ex);
 [[nodiscard]] std::vector<BoundingSphere> bounding_spheres(std::span<const Sphere> spheres, Executor& ex);
+// Bounding cubes of boxes (the max-norm ball: centre = box centre, radius = half the longest edge,
+// padded like the spheres). Used with kCubeKnobs; find_pairs grids boxes this way.
+[[nodiscard]] std::vector<BoundingSphere> bounding_cubes(std::span<const Box> boxes, Executor& ex);
+// The three into a caller's vector (a Workspace's: its capacity is reused).
+void bounding_spheres(std::span<const Sphere> spheres, Executor& ex, std::vector<BoundingSphere>& out);
+void bounding_cubes(std::span<const Box> boxes, Executor& ex, std::vector<BoundingSphere>& out);
 
 struct GridPlan {
     double cell_size = 0.0;
@@ -79,12 +89,35 @@ struct GridPlan {
 struct PlanKnobs {
     double coverage_scale = kCoverageScale;
     double min_cell_factor = kMinCellFactor;
+    double auto_cell_factor = kAutoCellFactor;
 };
+
+// Box input is gridded through its bounding CUBE instead (bounding_cubes: centre = box centre,
+// "radius" = half the longest edge, padded; a ball of the max-norm). For cubes the completeness
+// argument needs the coverage cube scaled by 2 (the larger of two overlapping cubes then always
+// covers the smaller one's home cell), and the duplicate-avoidance rule needs cell >= 4 rho_max,
+// which is exactly the scaled diameter: factor 1.0. For the AABB of a sphere this cell is 4 r
+// against the bounding sphere's 1.25 * 2 sqrt2 * sqrt3 r = 6.1 r (automatic: 7.35 r), so cells hold
+// (7.35 / 4.4)^3 ~ 4.7x fewer objects. docs/spatialhash.md, "Sizing: boxes"; sizing_test checks it.
+inline constexpr double kCubeCoverageScale = 2.0;
+inline constexpr double kCubeMinCellFactor = 1.0;
+// Automatic cell for cubes: kCubeAutoCellFactor x the largest scaled diameter (4 rho). Measured
+// on the benchmark's scenes (docs/spatialhash.md, "Performance log"): a smaller cell means fewer
+// proposals per object but more phantom entries to sort.
+inline constexpr double kCubeAutoCellFactor = 1.1;
+inline constexpr PlanKnobs kCubeKnobs{kCubeCoverageScale, kCubeMinCellFactor, kCubeAutoCellFactor};
 
 // Chooses the cell edge (requested_cell_size > 0, or automatic when 0), the outliers and the key
 // layout. Fails when a gridded object's cell coordinate would exceed kMaxCellCoordinate, naming it.
 [[nodiscard]] Result<GridPlan> plan_grid(std::span<const BoundingSphere> spheres, double requested_cell_size,
                                          Executor& ex, const PlanKnobs& knobs = {});
+// The same into a caller's plan and scratch (reused by a Workspace).
+struct PlanScratch {
+    std::vector<double> diameters;
+    std::vector<double> sorted;
+};
+[[nodiscard]] Result<bool> plan_grid(std::span<const BoundingSphere> spheres, double requested_cell_size, Executor& ex,
+                                     const PlanKnobs& knobs, GridPlan& plan, PlanScratch& scratch);
 
 // The cell key of integer cell coordinates (already wrapped to axis_bits), and its type (parity).
 [[nodiscard]] constexpr std::uint64_t cell_key(std::uint64_t x, std::uint64_t y, std::uint64_t z, unsigned b) {
@@ -125,11 +158,23 @@ void drop_sentinels(CellIdArray& ids, const GridPlan& plan, Executor& ex);
 // uses this one.
 [[nodiscard]] CellIdArray build_cell_entries(std::span<const BoundingSphere> spheres, const GridPlan& plan,
                                              Executor& ex);
+void build_cell_entries(std::span<const BoundingSphere> spheres, const GridPlan& plan, Executor& ex, CellIdArray& out,
+                        std::vector<std::size_t>& offset_scratch);
 
 // Stage 2. Stable LSD radix sort by the low key_bits bits of keys, digits of at most 11 bits (the
 // fewest passes); values follow
 // their keys. Digits on which every key agrees are skipped. values may be empty (keys only).
 void radix_sort(std::vector<std::uint64_t>& keys, std::vector<std::uint32_t>& values, unsigned key_bits, Executor& ex);
+// The same over bits [first_bit, end_bit) only, with caller-kept scratch arrays (a Workspace's):
+// after the call the scratch holds the previous buffers (the sort swaps them), sized >= keys.
+struct RadixScratch {
+    std::vector<std::uint64_t> keys;
+    std::vector<std::uint32_t> values;
+    std::vector<std::size_t> hist;
+    std::vector<std::size_t> digit_start;
+};
+void radix_sort_bits(std::vector<std::uint64_t>& keys, std::vector<std::uint32_t>& values, unsigned first_bit,
+                     unsigned end_bit, Executor& ex, RadixScratch& scratch);
 
 // Stage 3. One collision cell: entries [start, start + homes + phantoms) of the sorted arrays, H
 // entries first.
@@ -146,6 +191,9 @@ struct CollisionCells {
 [[nodiscard]] CollisionCells build_collision_cells(std::span<const std::uint64_t> sorted_keys,
                                                    std::span<const std::uint32_t> sorted_objects,
                                                    const GridPlan& plan, Executor& ex);
+void build_collision_cells(std::span<const std::uint64_t> sorted_keys, std::span<const std::uint32_t> sorted_objects,
+                           const GridPlan& plan, Executor& ex, CollisionCells& out,
+                           std::vector<std::uint32_t>& starts_scratch);
 
 // The exact test between objects i and j of the caller's input.
 struct Objects {
@@ -174,6 +222,8 @@ struct FilterBox {
 };
 [[nodiscard]] std::vector<FilterBox> filter_boxes(const Objects& objects, std::span<const BoundingSphere> spheres,
                                                   Executor& ex);
+void filter_boxes(const Objects& objects, std::span<const BoundingSphere> spheres, Executor& ex,
+                  std::vector<FilterBox>& out);
 [[nodiscard]] constexpr bool outer_overlap(const FilterBox& x, const FilterBox& y) {
     return x.lo[0] <= y.hi[0] && y.lo[0] <= x.hi[0] && x.lo[1] <= y.hi[1] && y.lo[1] <= x.hi[1] &&
            x.lo[2] <= y.hi[2] && y.lo[2] <= x.hi[2];
@@ -209,6 +259,21 @@ struct CollideCounts {
                                               std::span<const std::uint16_t> control, const Objects& objects,
                                               std::span<const FilterBox> filter, Executor& ex,
                                               CollideCounts* counts = nullptr);
+// The same into `out`, with the per-item buffers kept in `scratch` between calls (a Workspace's).
+struct CollideScratch {
+    struct Item {
+        std::uint32_t begin;  // into cells.cells
+        std::uint32_t end;
+    };
+    std::vector<Item> items;
+    std::vector<std::array<std::vector<Pair>, kSlots>> found;  // per item, per cell type
+    std::vector<CollideCounts> item_counts;
+    std::vector<std::size_t> offsets;
+};
+CollideCounts collide_cells(const CollisionCells& cells, std::span<const std::uint32_t> sorted_objects,
+                            std::span<const std::uint16_t> control, const Objects& objects,
+                            std::span<const FilterBox> filter, Executor& ex, std::vector<Pair>& out,
+                            CollideScratch& scratch);
 
 // Huge objects against every object (each pair once), count -> scan -> fill.
 [[nodiscard]] std::vector<Pair> collide_huge(std::span<const std::uint32_t> huge_ids, std::span<const std::uint8_t> huge,
@@ -217,9 +282,34 @@ struct CollideCounts {
 
 // Sorts pairs by (a, b) (radix sort on a << 32 | b).
 void sort_pairs(std::vector<Pair>& pairs, std::size_t object_count, Executor& ex);
+// The same with caller-kept scratch (a Workspace's). Radix sort on the bits of a in use, then each
+// run of equal a sorted by b (the pairs must be unique, as every stage's output is).
+void sort_pairs(std::vector<Pair>& pairs, std::size_t object_count, Executor& ex, std::vector<std::uint64_t>& keys,
+                RadixScratch& scratch);
+
+// Every array of the grid pipeline, kept between calls by spatialhash::Workspace so that a frame
+// of the same or a smaller scene allocates nothing proportional to n or to the pairs.
+struct GridWorkspace {
+    std::vector<BoundingSphere> bounds;
+    GridPlan plan;
+    PlanScratch plan_scratch;
+    CellIdArray ids;
+    std::vector<std::size_t> entry_offsets;
+    RadixScratch radix;        // the cell-key sort
+    RadixScratch radix_pairs;  // the pair sort (its own, so that the two sizes never trade buffers)
+    CollisionCells cells;
+    std::vector<std::uint32_t> cell_starts;
+    std::vector<FilterBox> filter;
+    CollideScratch collide;
+    std::vector<std::uint64_t> pair_keys;
+};
 
 // The whole grid pipeline on validated input (find_pairs calls it after validation).
 [[nodiscard]] Result<PairSet> grid_find_pairs(const Objects& objects, std::span<const BoundingSphere> spheres,
                                               double requested_cell_size, Executor& ex, const PlanKnobs& knobs = {});
+// The same with the workspace's arrays; the bounding volumes must already be in ws.bounds. The pairs
+// go into `pairs` (its capacity reused), the statistics are returned.
+[[nodiscard]] Result<Stats> grid_find_pairs(const Objects& objects, double requested_cell_size, Executor& ex,
+                                            const PlanKnobs& knobs, GridWorkspace& ws, std::vector<Pair>& pairs);
 
 }  // namespace spatialhash::detail
