@@ -1,7 +1,9 @@
 // execute.cpp: the scalar reference executor and the tiled (optionally multithreaded) executor.
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -154,7 +156,28 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
     std::vector<std::vector<detail::SetupTri>> per_draw(draw_cmds.size());
     std::vector<std::vector<detail::BoundsTri>> per_draw_bounds(draw_cmds.size());  // exact-bounds draws
     std::vector<std::vector<detail::BoundsVertex>> per_draw_pool(draw_cmds.size());
-    run_parallel(threads, draw_cmds.size(), [&](std::size_t d) {
+    // With several threads, a big GL-exact draw is split into pieces of kFrontEndPiece triangles;
+    // piece 0 fills the draw's list, the others their own lists, appended after in piece order
+    // (so the list is the same as one serial pass, whatever the thread count).
+    constexpr std::size_t kFrontEndPiece = 2048;
+    struct Piece {
+        std::uint32_t draw;
+        std::size_t k0, k1;  // index range [k0, k1) of the draw's index list (whole triangles)
+    };
+    std::vector<Piece> pieces;
+    for (std::size_t d = 0; d < draw_cmds.size(); ++d) {
+        const Command& c = cmds[draw_cmds[d]];
+        const std::size_t n = c.state.mode == RasterMode::ExactBounds ? 0 : c.mesh.indices.size() / 3 * 3;
+        if (threads == 1 || n <= 3 * kFrontEndPiece) {
+            pieces.push_back({static_cast<std::uint32_t>(d), 0, n});
+            continue;
+        }
+        for (std::size_t k = 0; k < n; k += 3 * kFrontEndPiece)
+            pieces.push_back({static_cast<std::uint32_t>(d), k, std::min(n, k + 3 * kFrontEndPiece)});
+    }
+    std::vector<std::vector<detail::SetupTri>> piece_out(pieces.size());
+    run_parallel(threads, pieces.size(), [&](std::size_t j) {
+        const std::size_t d = pieces[j].draw;
         const Command& c = cmds[draw_cmds[d]];
         const detail::FrontEndParams p = params_for(target, c.state);
         if (c.state.mode == RasterMode::ExactBounds) {
@@ -163,10 +186,14 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
         }
         const auto& idx = c.mesh.indices;
         const auto& vtx = c.mesh.vertices;
-        auto& out = per_draw[d];
-        for (std::size_t k = 0; k + 2 < idx.size(); k += 3)
+        auto& out = pieces[j].k0 == 0 ? per_draw[d] : piece_out[j];
+        out.reserve(out.size() + (pieces[j].k1 - pieces[j].k0) / 3);  // one SetupTri per unclipped triangle
+        for (std::size_t k = pieces[j].k0; k + 2 < pieces[j].k1; k += 3)
             detail::setup_triangle(p, vtx[idx[k]], vtx[idx[k + 1]], vtx[idx[k + 2]], draw_cmds[d], out);
     });
+    for (std::size_t j = 0; j < pieces.size(); ++j)
+        if (pieces[j].k0 != 0)
+            per_draw[pieces[j].draw].insert(per_draw[pieces[j].draw].end(), piece_out[j].begin(), piece_out[j].end());
 
     // Binning: each tile lists the triangles overlapping it, in command order.
     const int tiles_x = (target.width() + kTileSize - 1) / kTileSize;
@@ -177,22 +204,47 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
         std::uint32_t tri;
     };
     std::vector<std::vector<Ref>> bins(tile_count);
-    auto bin = [&](std::size_t d, std::size_t t, int bx0, int by0, int bx1, int by1) {
-        for (int ty = by0 / kTileSize; ty <= by1 / kTileSize; ++ty)
-            for (int tx = bx0 / kTileSize; tx <= bx1 / kTileSize; ++tx)
-                bins[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x) + static_cast<std::size_t>(tx)]
-                    .push_back({static_cast<std::uint32_t>(d), static_cast<std::uint32_t>(t)});
-    };
-    for (std::size_t d = 0; d < per_draw.size(); ++d) {
-        for (std::size_t t = 0; t < per_draw[d].size(); ++t) {
-            const auto& tri = per_draw[d][t];
-            bin(d, t, tri.x0, tri.y0, tri.x1, tri.y1);
+    // Parallel binning over bands of tile rows: each band walks every triangle in command order and
+    // fills only its own tiles, so every bin is the same list for any thread count.
+    const int bands = threads > 1 ? std::min(threads, tiles_y) : 1;
+    run_parallel(threads, static_cast<std::size_t>(bands), [&](std::size_t band) {
+        const int band_ty0 = static_cast<int>(static_cast<std::size_t>(tiles_y) * band / static_cast<std::size_t>(bands));
+        const int band_ty1 =
+            static_cast<int>(static_cast<std::size_t>(tiles_y) * (band + 1) / static_cast<std::size_t>(bands)) - 1;
+        auto bin = [&](std::size_t d, std::size_t t, int bx0, int by0, int bx1, int by1) {
+            for (int ty = std::max(by0 / kTileSize, band_ty0); ty <= std::min(by1 / kTileSize, band_ty1); ++ty)
+                for (int tx = bx0 / kTileSize; tx <= bx1 / kTileSize; ++tx)
+                    bins[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x) + static_cast<std::size_t>(tx)]
+                        .push_back({static_cast<std::uint32_t>(d), static_cast<std::uint32_t>(t)});
+        };
+        for (std::size_t d = 0; d < per_draw.size(); ++d) {
+            for (std::size_t t = 0; t < per_draw[d].size(); ++t) {
+                const auto& tri = per_draw[d][t];
+                const int ty0 = std::max(tri.y0 / kTileSize, band_ty0), ty1 = std::min(tri.y1 / kTileSize, band_ty1);
+                if (ty0 > ty1) continue;
+                if (tri.y0 / kTileSize == tri.y1 / kTileSize && tri.x0 / kTileSize == tri.x1 / kTileSize) {
+                    bin(d, t, tri.x0, tri.y0, tri.x1, tri.y1);
+                    continue;
+                }
+                // GL-exact triangles over several tiles: tile-level trivial reject (no centre of the
+                // tile's part of the box is covered), exact integers (detail::rect_outside).
+                for (int ty = ty0; ty <= ty1; ++ty)
+                    for (int tx = tri.x0 / kTileSize; tx <= tri.x1 / kTileSize; ++tx) {
+                        const int rx0 = std::max(tri.x0, tx * kTileSize);
+                        const int rx1 = std::min(tri.x1, tx * kTileSize + kTileSize - 1);
+                        const int ry0 = std::max(tri.y0, ty * kTileSize);
+                        const int ry1 = std::min(tri.y1, ty * kTileSize + kTileSize - 1);
+                        if (detail::rect_outside(tri, rx0, ry0, rx1, ry1)) continue;
+                        bins[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x) + static_cast<std::size_t>(tx)]
+                            .push_back({static_cast<std::uint32_t>(d), static_cast<std::uint32_t>(t)});
+                    }
+            }
+            for (std::size_t t = 0; t < per_draw_bounds[d].size(); ++t) {
+                const auto& tri = per_draw_bounds[d][t];
+                bin(d, t, tri.x0, tri.y0, tri.x1, tri.y1);
+            }
         }
-        for (std::size_t t = 0; t < per_draw_bounds[d].size(); ++t) {
-            const auto& tri = per_draw_bounds[d][t];
-            bin(d, t, tri.x0, tri.y0, tri.x1, tri.y1);
-        }
-    }
+    });
 
     // Back end: one task per tile; counters kept per tile as (query, count) runs.
     std::vector<std::vector<std::pair<std::uint32_t, std::uint64_t>>> tile_counts(tile_count);
@@ -200,6 +252,9 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
     const int width = target.width();
     const int height = target.height();
     const DepthFormat format = target.format();
+    const auto& query_kinds = batch.query_kinds();
+    const std::unique_ptr<std::atomic<bool>[]> answered(new std::atomic<bool>[query_kinds.size() + 1]);
+    for (std::size_t q = 0; q <= query_kinds.size(); ++q) answered[q].store(false, std::memory_order_relaxed);
     run_parallel(threads, tile_count, [&](std::size_t tile) {
         const int tx = static_cast<int>(tile % static_cast<std::size_t>(tiles_x));
         const int ty = static_cast<int>(tile / static_cast<std::size_t>(tiles_x));
@@ -216,10 +271,20 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
                                              c.state.depth_write, depth, width, std::max(x0, tri.x0),
                                              std::max(y0, tri.y0), std::min(x1, tri.x1), std::min(y1, tri.y1));
             } else {
+                // Any-samples query with the mask off: once this query has a passing sample (in this
+                // tile, or in any tile: the flag), further draws in it change nothing; the kernel
+                // also stops at its first passing row. The boolean is the same whatever the schedule.
+                const std::uint32_t aq = cmd_query[cmd];
+                const bool any_only = aq != kNoQuery && !c.state.depth_write &&
+                                      query_kinds[aq] == QueryKind::AnySamplesPassed;
+                if (any_only && ((!counts.empty() && counts.back().first == aq) ||
+                                 answered[aq].load(std::memory_order_relaxed)))
+                    continue;
                 const auto& tri = per_draw[r.draw][r.tri];
                 passed = detail::raster_rect(tri, format, c.state.depth_func, c.state.depth_write, depth, width,
                                              std::max(x0, tri.x0), std::max(y0, tri.y0), std::min(x1, tri.x1),
-                                             std::min(y1, tri.y1), options.allow_simd);
+                                             std::min(y1, tri.y1), options.allow_simd, any_only);
+                if (any_only && passed != 0) answered[aq].store(true, std::memory_order_relaxed);
             }
             const std::uint32_t q = cmd_query[cmd];
             if (q == kNoQuery || passed == 0) continue;

@@ -1,20 +1,249 @@
-// kernel_avx2.cpp: the same kernel compiled with AVX2 + FMA (CMake sets -mavx2 -mfma on this file
-// only, x86-64 GCC/Clang), so std::fma is one instruction instead of a libm call. Chosen at run
-// time by kernel_avx2_available(); elsewhere this file builds the portable kernel under this name.
+// kernel_avx2.cpp: the 8-wide AVX2 + FMA GL-exact kernel. CMake compiles this file alone with
+// -mavx2 -mfma (x86-64 GCC/Clang, RASTER_KERNEL_AVX2=1); it is chosen at run time by
+// kernel_avx2_available(). Elsewhere (aarch64, other compilers) the same entry point builds the
+// scalar kernel of raster_kernel.inc, and kernel_avx2_available() says false.
+//
+// Layout: 8x1 pixels per step along a row. Coverage stays exact integer arithmetic on the same
+// 16.8 edge functions (same snapping, same fill-rule bias folded into c): narrow rectangles test
+// 8 pixels at once in 32-bit lanes when a bound proves no value overflows; wider ones solve each
+// row's covered span with the scalar code (edge_span of raster_kernel.inc, 64-bit floor divisions).
+// Either way the covered set is the scalar path's. The vector part is depth; per 8 pixels:
+//   z = fma(dzdy, y, fma(dzdx, x, z0))   (_mm256_fmadd_ps: one correctly rounded fma, as std::fma)
+//   clamp: max(z, 0) then min(z, 1)      (maxps returns its second operand when z is NaN: NaN -> 0,
+//                                         -0 -> +0, exactly `z > 0 ? z : 0`; minps likewise)
+//   D24: cvtps2dq(z * 16777215)          (MXCSR round-to-nearest-even, as lrint)
+//   D16: bits(z * (65535/65536) + 128) & 0xffff
+//   D32F: compare as floats with the ordered/unordered predicate equal to C++'s operator
+// Stores are masked (maskstore) on partial chunks and blended on full ones, never touching a pixel
+// outside the span, so tiles on other threads are never read or written.
+// Block-level trivial reject / accept: the three edge functions are evaluated at the four corner
+// pixel centres of the rectangle (a linear function takes its extremes at corners): an edge <= 0 at
+// all four rejects the whole rectangle; an edge > 0 at all four is dropped from the span work
+// (wide rectangles; narrow ones go straight to the 8-lane coverage test, which rejects as cheaply).
+// stop_at_first (any-samples queries, mask off): return after the first row with a passing sample.
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdlib>
 
 #include "pipeline.h"
+
+#if defined(RASTER_KERNEL_AVX2)
+#include <immintrin.h>
+#endif
 
 namespace raster::detail {
 namespace avx2 {
 #include "raster_kernel.inc"
 }  // namespace avx2
 
+#if defined(RASTER_KERNEL_AVX2)
+namespace {
+
+template <DepthFormat Fmt>
+inline __m256i encode8(__m256 z) {
+    if constexpr (Fmt == DepthFormat::D24) {
+        return _mm256_cvtps_epi32(_mm256_mul_ps(z, _mm256_set1_ps(16777215.0f)));
+    } else if constexpr (Fmt == DepthFormat::D16) {
+        const __m256 t = _mm256_mul_ps(z, _mm256_set1_ps(65535.0f / 65536.0f));
+        const __m256 u = _mm256_add_ps(t, _mm256_set1_ps(128.0f));
+        return _mm256_and_si256(_mm256_castps_si256(u), _mm256_set1_epi32(0xffff));
+    } else {
+        return _mm256_castps_si256(z);
+    }
+}
+
+// All-ones lanes where depth_pass<F>(incoming, stored) holds, for 8 lanes.
+template <DepthFormat Fmt, DepthFunc F>
+inline __m256i pass8(__m256i incoming, __m256i stored) {
+    const __m256i ones = _mm256_set1_epi32(-1);
+    if constexpr (F == DepthFunc::Never) return _mm256_setzero_si256();
+    if constexpr (F == DepthFunc::Always) return ones;
+    if constexpr (Fmt == DepthFormat::D32F) {
+        const __m256 a = _mm256_castsi256_ps(incoming), b = _mm256_castsi256_ps(stored);
+        if constexpr (F == DepthFunc::Less) return _mm256_castps_si256(_mm256_cmp_ps(a, b, _CMP_LT_OQ));
+        if constexpr (F == DepthFunc::Equal) return _mm256_castps_si256(_mm256_cmp_ps(a, b, _CMP_EQ_OQ));
+        if constexpr (F == DepthFunc::LEqual) return _mm256_castps_si256(_mm256_cmp_ps(a, b, _CMP_LE_OQ));
+        if constexpr (F == DepthFunc::Greater) return _mm256_castps_si256(_mm256_cmp_ps(a, b, _CMP_GT_OQ));
+        if constexpr (F == DepthFunc::NotEqual) return _mm256_castps_si256(_mm256_cmp_ps(a, b, _CMP_NEQ_UQ));
+        if constexpr (F == DepthFunc::GEqual) return _mm256_castps_si256(_mm256_cmp_ps(a, b, _CMP_GE_OQ));
+    } else {
+        // Unsigned 32-bit order through a sign flip and the signed compare.
+        const __m256i bias = _mm256_set1_epi32(static_cast<int>(0x80000000u));
+        const __m256i a = _mm256_xor_si256(incoming, bias), b = _mm256_xor_si256(stored, bias);
+        if constexpr (F == DepthFunc::Less) return _mm256_cmpgt_epi32(b, a);
+        if constexpr (F == DepthFunc::Equal) return _mm256_cmpeq_epi32(a, b);
+        if constexpr (F == DepthFunc::LEqual) return _mm256_xor_si256(_mm256_cmpgt_epi32(a, b), ones);
+        if constexpr (F == DepthFunc::Greater) return _mm256_cmpgt_epi32(a, b);
+        if constexpr (F == DepthFunc::NotEqual) return _mm256_xor_si256(_mm256_cmpeq_epi32(a, b), ones);
+        if constexpr (F == DepthFunc::GEqual) return _mm256_xor_si256(_mm256_cmpgt_epi32(b, a), ones);
+    }
+    return _mm256_setzero_si256();
+}
+
+inline unsigned lanes(__m256i m) {
+    return static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(m)));
+}
+
+// Edge i at pixel centre (px, py), exactly as the scalar span solver sees it.
+inline std::int64_t edge_at(const SetupTri& t, int i, int px, int py) {
+    return t.c[i] - t.dcdx[i] * 256 * px + t.dcdy[i] * 256 * py;
+}
+
+// Depth test (and write) of the 8 pixels px..px+7 of `row` at row centre fy; `cover` marks the
+// pixels to process (full: all 8, plain load and blended store). Returns the passing-lane bits.
+template <DepthFormat Fmt, DepthFunc F, bool Write>
+inline unsigned chunk8(const SetupTri& t, std::uint32_t* row, int px, __m256 fy, __m256i cover, bool full) {
+    const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const __m256 fx = _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(px), iota));
+    __m256 z = _mm256_fmadd_ps(_mm256_set1_ps(t.dzdy), fy, _mm256_fmadd_ps(_mm256_set1_ps(t.dzdx), fx, _mm256_set1_ps(t.z0)));
+    z = _mm256_max_ps(z, _mm256_setzero_ps());
+    z = _mm256_min_ps(z, _mm256_set1_ps(1.0f));
+    const __m256i incoming = encode8<Fmt>(z);
+    std::uint32_t* p = row + px;
+    const __m256i stored = full ? _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p))
+                                : _mm256_maskload_epi32(reinterpret_cast<const int*>(p), cover);
+    const __m256i pass = _mm256_and_si256(pass8<Fmt, F>(incoming, stored), cover);
+    const unsigned bits = lanes(pass);
+    if constexpr (Write) {
+        if (bits != 0) {
+            if (full)
+                _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), _mm256_blendv_epi8(stored, incoming, pass));
+            else
+                _mm256_maskstore_epi32(reinterpret_cast<int*>(p), pass, incoming);
+        }
+    }
+    return bits;
+}
+
+constexpr int kNarrow = 16;  // rectangles narrower than this take the per-chunk edge path when it fits
+
+template <DepthFormat Fmt, DepthFunc F, bool Write>
+std::uint64_t raster_rect8(const SetupTri& t, std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1,
+                           bool stop_at_first) {
+    const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    std::uint64_t passed = 0;
+    if (rx1 - rx0 < kNarrow) {
+        // Narrow rectangles (small triangles, box edges): coverage per 8 pixels from the three edge
+        // functions in 32-bit lanes, when every value they take over the rectangle (padded to whole
+        // chunks of 8) fits: |e| <= |e(rx0, ry0)| + |x step| * (width + 7) + |y step| * (height - 1)
+        // < 2^31. Exact: the same integers as the 64-bit span solver, without its divisions.
+        std::int64_t e_row[3], sx[3], sy[3];
+        bool fits = true;
+        #pragma GCC unroll 3
+        for (int i = 0; i < 3; ++i) {
+            e_row[i] = edge_at(t, i, rx0, ry0);
+            sx[i] = t.dcdx[i] * 256;
+            sy[i] = t.dcdy[i] * 256;
+            const std::int64_t bound =
+                std::abs(e_row[i]) + std::abs(sx[i]) * (rx1 - rx0 + 8) + std::abs(sy[i]) * (ry1 - ry0);
+            fits = fits && bound < (std::int64_t{1} << 31);
+        }
+        if (fits) {
+            __m256i lane_sx[3];
+            #pragma GCC unroll 3
+            for (int i = 0; i < 3; ++i)
+                lane_sx[i] = _mm256_mullo_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(sx[i])), iota);
+            const __m256i zero_i = _mm256_setzero_si256();
+            for (int py = ry0; py <= ry1; ++py) {
+                std::uint32_t* row = depth + static_cast<std::size_t>(py) * static_cast<std::size_t>(stride);
+                const __m256 fy = _mm256_set1_ps(static_cast<float>(py));
+                std::int32_t e_chunk[3];
+                #pragma GCC unroll 3
+                for (int i = 0; i < 3; ++i) e_chunk[i] = static_cast<std::int32_t>(e_row[i]);
+                for (int px = rx0; px <= rx1; px += 8) {
+                    __m256i cover = _mm256_cmpgt_epi32(_mm256_set1_epi32(rx1 - px + 1), iota);
+                    #pragma GCC unroll 3
+                    for (int i = 0; i < 3; ++i) {
+                        const __m256i e = _mm256_sub_epi32(_mm256_set1_epi32(e_chunk[i]), lane_sx[i]);
+                        cover = _mm256_and_si256(cover, _mm256_cmpgt_epi32(e, zero_i));
+                        e_chunk[i] -= static_cast<std::int32_t>(sx[i] * 8);  // within the bound
+                    }
+                    const unsigned m = lanes(cover);
+                    if (m == 0) continue;
+                    passed += static_cast<unsigned>(
+                        std::popcount(chunk8<Fmt, F, Write>(t, row, px, fy, cover, m == 0xffu)));
+                }
+                #pragma GCC unroll 3
+                for (int i = 0; i < 3; ++i) e_row[i] += sy[i];
+                if (stop_at_first && passed != 0) return passed;
+            }
+            return passed;
+        }
+    }
+
+    // Block-level classification of the rectangle against each edge (corner centres).
+    int edges[3];
+    int n_edges = 0;
+#pragma GCC unroll 3
+    for (int i = 0; i < 3; ++i) {
+        const std::int64_t e00 = edge_at(t, i, rx0, ry0), e10 = edge_at(t, i, rx1, ry0);
+        const std::int64_t e01 = edge_at(t, i, rx0, ry1), e11 = edge_at(t, i, rx1, ry1);
+        if (e00 <= 0 && e10 <= 0 && e01 <= 0 && e11 <= 0) return 0;  // trivial reject
+        if (!(e00 > 0 && e10 > 0 && e01 > 0 && e11 > 0)) edges[n_edges++] = i;  // else trivially inside
+    }
+
+    // Otherwise each row's span from the 64-bit edge functions (the scalar solver).
+    const __m256i all = _mm256_set1_epi32(-1);
+    for (int py = ry0; py <= ry1; ++py) {
+        std::int64_t lo = rx0, hi = rx1;
+        for (int k = 0; k < n_edges; ++k) {
+            const int i = edges[k];
+            avx2::edge_span(t.c[i] + t.dcdy[i] * 256 * py, t.dcdx[i], lo, hi);
+        }
+        if (lo > hi) continue;
+        std::uint32_t* row = depth + static_cast<std::size_t>(py) * static_cast<std::size_t>(stride);
+        const __m256 fy = _mm256_set1_ps(static_cast<float>(py));
+        const int ihi = static_cast<int>(hi);
+        int px = static_cast<int>(lo);
+        for (; px + 7 <= ihi; px += 8)
+            passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(t, row, px, fy, all, true)));
+        if (px <= ihi) {
+            const __m256i cover = _mm256_cmpgt_epi32(_mm256_set1_epi32(ihi - px + 1), iota);
+            passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(t, row, px, fy, cover, false)));
+        }
+        if (stop_at_first && passed != 0) return passed;
+    }
+    return passed;
+}
+
+template <DepthFormat Fmt, DepthFunc F>
+std::uint64_t by_write(bool w, const SetupTri& t, std::uint32_t* d, int s, int a, int b, int c, int e, bool stop) {
+    return w ? raster_rect8<Fmt, F, true>(t, d, s, a, b, c, e, stop) : raster_rect8<Fmt, F, false>(t, d, s, a, b, c, e, stop);
+}
+
+template <DepthFormat Fmt>
+std::uint64_t by_func(DepthFunc f, bool w, const SetupTri& t, std::uint32_t* d, int s, int a, int b, int c, int e,
+                      bool stop) {
+    switch (f) {
+        case DepthFunc::Never: return by_write<Fmt, DepthFunc::Never>(w, t, d, s, a, b, c, e, stop);
+        case DepthFunc::Less: return by_write<Fmt, DepthFunc::Less>(w, t, d, s, a, b, c, e, stop);
+        case DepthFunc::Equal: return by_write<Fmt, DepthFunc::Equal>(w, t, d, s, a, b, c, e, stop);
+        case DepthFunc::LEqual: return by_write<Fmt, DepthFunc::LEqual>(w, t, d, s, a, b, c, e, stop);
+        case DepthFunc::Greater: return by_write<Fmt, DepthFunc::Greater>(w, t, d, s, a, b, c, e, stop);
+        case DepthFunc::NotEqual: return by_write<Fmt, DepthFunc::NotEqual>(w, t, d, s, a, b, c, e, stop);
+        case DepthFunc::GEqual: return by_write<Fmt, DepthFunc::GEqual>(w, t, d, s, a, b, c, e, stop);
+        case DepthFunc::Always: return by_write<Fmt, DepthFunc::Always>(w, t, d, s, a, b, c, e, stop);
+    }
+    return 0;
+}
+
+}  // namespace
+#endif
+
 std::uint64_t raster_rect_avx2(const SetupTri& tri, DepthFormat format, DepthFunc func, bool write,
-                               std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1) {
-    return avx2::raster_rect_kernel(tri, format, func, write, depth, stride, rx0, ry0, rx1, ry1);
+                               std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1,
+                               bool stop_at_first) {
+#if defined(RASTER_KERNEL_AVX2)
+    switch (format) {
+        case DepthFormat::D16: return by_func<DepthFormat::D16>(func, write, tri, depth, stride, rx0, ry0, rx1, ry1, stop_at_first);
+        case DepthFormat::D24: return by_func<DepthFormat::D24>(func, write, tri, depth, stride, rx0, ry0, rx1, ry1, stop_at_first);
+        case DepthFormat::D32F: return by_func<DepthFormat::D32F>(func, write, tri, depth, stride, rx0, ry0, rx1, ry1, stop_at_first);
+    }
+    return 0;
+#else
+    return avx2::raster_rect_kernel(tri, format, func, write, depth, stride, rx0, ry0, rx1, ry1, stop_at_first);
+#endif
 }
 
 bool kernel_avx2_available() {

@@ -10,6 +10,7 @@
 // (depth plane), lp_bld_interp.c (per-pixel evaluation), lp_bld_conv.c (unorm conversion).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -51,14 +52,35 @@ void setup_triangle(const FrontEndParams& params, const Float4& a, const Float4&
 
 // Rasterizes `tri` over the rectangle [rx0, rx1] x [ry0, ry1] (inclusive, inside the target and the
 // triangle's box) into `depth` (row-major, `stride` values per row). Returns the samples that passed.
-// allow_simd picks the AVX2+FMA build of the kernel when the CPU has it (bit-identical results).
+// allow_simd picks the 8-wide AVX2+FMA kernel when the CPU has it and the environment variable
+// CULLIDE_RASTER_NO_SIMD is not set to a non-empty value other than "0" (bit-identical results).
+// stop_at_first: the caller only needs to know whether any sample passes (an any-samples query
+// with the depth mask off): the kernel may return any count >= 1 as soon as one sample passed.
 std::uint64_t raster_rect(const SetupTri& tri, DepthFormat format, DepthFunc func, bool write,
-                          std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1, bool allow_simd);
+                          std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1, bool allow_simd,
+                          bool stop_at_first = false);
 std::uint64_t raster_rect_portable(const SetupTri& tri, DepthFormat format, DepthFunc func, bool write,
-                                   std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1);
+                                   std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1,
+                                   bool stop_at_first);
 std::uint64_t raster_rect_avx2(const SetupTri& tri, DepthFormat format, DepthFunc func, bool write,
-                               std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1);
+                               std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1,
+                               bool stop_at_first);
+// True when the CPU has AVX2 and FMA and this build has the AVX2 kernel (x86-64 GCC/Clang).
 bool kernel_avx2_available();
+// False when CULLIDE_RASTER_NO_SIMD forces the portable kernel everywhere (read once).
+bool simd_allowed_by_environment();
+
+// True when no pixel centre of [x0, x1] x [y0, y1] can be covered by `t`: one edge function is <= 0
+// at all four corner centres (edge functions are linear, so at every centre). Exact integers.
+inline bool rect_outside(const SetupTri& t, int x0, int y0, int x1, int y1) {
+    for (int i = 0; i < 3; ++i) {
+        const std::int64_t ex0 = -t.dcdx[i] * 256 * x0, ex1 = -t.dcdx[i] * 256 * x1;
+        const std::int64_t ey0 = t.dcdy[i] * 256 * y0, ey1 = t.dcdy[i] * 256 * y1;
+        const std::int64_t best = t.c[i] + std::max(ex0, ex1) + std::max(ey0, ey1);
+        if (best <= 0) return true;
+    }
+    return false;
+}
 
 
 }  // namespace raster::detail

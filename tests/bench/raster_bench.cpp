@@ -9,7 +9,10 @@
 //     GEQUAL query with the mask off followed by a LEQUAL draw with the mask on: CULLIDE's pattern.
 //   SmallTris/<size>/<threads>: 20000 triangles of ~8 px^2, LESS, writes on.
 //   LargeTris/<size>/<threads>: 200 triangles covering ~1/8 of the target each, LESS, writes on.
-// threads = 0 means the OSMesa oracle (llvmpipe with its default thread count).
+//   CullideAny/<size>/<threads>: Cullide with any-samples queries (what cullide.cpp issues): the
+//     executor stops a query at its first passing sample.
+// threads = 0 means the OSMesa oracle (llvmpipe with its default thread count). A third argument
+// simd: 1 = default kernel choice (AVX2 8-wide when the CPU has it), 0 = the portable kernel.
 //   Reliable/<size>/<mode>: the Cullide workload's 2000 boxes (world = clip: a [-1, 1]^3 view along
 //     z), one thread, CPU time, in the three ways CULLIDE can run: mode 0 GL-exact (float, pixel
 //     centres), 1 exact-bounds (double, conservative), 2 R-CULLIDE offset boxes per triangle (12
@@ -19,6 +22,8 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
@@ -51,14 +56,14 @@ struct Workload {
     std::size_t queries = 0;
 };
 
-enum class Kind { Cullide, SmallTris, LargeTris };
+enum class Kind { Cullide, SmallTris, LargeTris, CullideAny };
 
 std::unique_ptr<Workload> make_workload(Kind kind, int size) {
     auto w = std::make_unique<Workload>();
     w->batch = raster::CommandBatch(size, size);
     Rng rng{static_cast<std::uint64_t>(size) * 31 + static_cast<std::uint64_t>(kind)};
     const float px = 2.0f / static_cast<float>(size);  // one pixel in NDC
-    if (kind == Kind::Cullide) {
+    if (kind == Kind::Cullide || kind == Kind::CullideAny) {
         const int objects = 2000;
         w->indices.resize(1);
         // A box: 8 corners, 12 triangles (shared vertex list per object, indices rebased).
@@ -79,7 +84,8 @@ std::unique_ptr<Workload> make_workload(Kind kind, int size) {
             raster::DrawState q;
             q.depth_func = raster::DepthFunc::GEqual;
             q.depth_write = false;
-            w->batch.begin_query(raster::QueryKind::SamplesPassed);
+            w->batch.begin_query(kind == Kind::CullideAny ? raster::QueryKind::AnySamplesPassed
+                                                          : raster::QueryKind::SamplesPassed);
             w->batch.draw(m, q);
             w->batch.end_query();
             raster::DrawState d;
@@ -118,13 +124,14 @@ std::uint64_t digest(const raster::QueryResults& r) {
 void run(benchmark::State& state, Kind kind) {
     const int size = static_cast<int>(state.range(0));
     const int threads = static_cast<int>(state.range(1));
+    const bool simd = state.range(2) != 0;
     const auto w = make_workload(kind, size);
     auto target = raster::DepthTarget::create(size, size, raster::DepthFormat::D24);
     if (!target.ok()) {
         state.SkipWithError(target.error().message.c_str());
         return;
     }
-    auto ours = raster::execute(target.value(), w->batch, raster::ExecuteOptions{threads > 0 ? threads : 1});
+    auto ours = raster::execute(target.value(), w->batch, raster::ExecuteOptions{threads > 0 ? threads : 1, simd});
     if (!ours.ok()) {
         state.SkipWithError(ours.error().message.c_str());
         return;
@@ -161,18 +168,21 @@ void run(benchmark::State& state, Kind kind) {
     if (threads > 0) {
         for (auto _ : state) {
             (void)target.value().clear(1.0);
-            auto r = raster::execute(target.value(), w->batch, raster::ExecuteOptions{threads});
+            auto r = raster::execute(target.value(), w->batch, raster::ExecuteOptions{threads, simd});
             benchmark::DoNotOptimize(r);
         }
     }
     state.counters["tris/s"] = benchmark::Counter(static_cast<double>(w->triangles), benchmark::Counter::kIsIterationInvariantRate);
     state.counters["queries/s"] = benchmark::Counter(static_cast<double>(w->queries), benchmark::Counter::kIsIterationInvariantRate);
-    state.SetLabel(threads == 0 ? "osmesa-llvmpipe" : "cullide-raster");
+    state.SetLabel(threads == 0 ? "osmesa-llvmpipe" : (simd ? "cullide-raster" : "cullide-raster-portable"));
 }
 
 void args(benchmark::internal::Benchmark* b) {
     for (const int size : {256, 1024, 4096})
-        for (const int threads : {0, 1, 2}) b->Args({size, threads});
+        for (const int threads : {0, 1, 2}) {
+            b->Args({size, threads, 1});
+            if (threads == 1) b->Args({size, threads, 0});  // the portable (scalar) kernel, SIMD off
+        }
     b->Unit(benchmark::kMillisecond)->UseRealTime();
 }
 
@@ -259,5 +269,52 @@ BENCHMARK(run_reliable)->ArgsProduct({{256, 1024}, {0, 1, 2, 3}})->Unit(benchmar
 BENCHMARK_CAPTURE(run, Cullide, Kind::Cullide)->Apply(args);
 BENCHMARK_CAPTURE(run, SmallTris, Kind::SmallTris)->Apply(args);
 BENCHMARK_CAPTURE(run, LargeTris, Kind::LargeTris)->Apply(args);
+BENCHMARK_CAPTURE(run, CullideAny, Kind::CullideAny)->Apply(args);
 
-BENCHMARK_MAIN();
+namespace {
+
+// raster_bench --once <Cullide|CullideAny|SmallTris|LargeTris> <size> <simd 0|1> [threads]: one
+// execute() of a workload and its query digest, no timing: for instruction counts, e.g.
+//   valgrind --tool=callgrind --collect-atstart=no --toggle-collect='raster::execute(raster::DepthTarget&,
+//     raster::CommandBatch const&, raster::ExecuteOptions const&)' raster_bench --once LargeTris 1024 1
+int run_once(int argc, char** argv) {
+    const std::string name = argv[2];
+    Kind kind;
+    if (name == "Cullide") kind = Kind::Cullide;
+    else if (name == "CullideAny") kind = Kind::CullideAny;
+    else if (name == "SmallTris") kind = Kind::SmallTris;
+    else if (name == "LargeTris") kind = Kind::LargeTris;
+    else {
+        std::fprintf(stderr, "raster_bench --once: unknown workload '%s'\n", argv[2]);
+        return 2;
+    }
+    const int size = std::atoi(argv[3]);
+    const bool simd = std::atoi(argv[4]) != 0;
+    const int threads = argc > 5 ? std::atoi(argv[5]) : 1;
+    if (size < 1 || size > 16384 || threads < 1) {
+        std::fprintf(stderr, "raster_bench --once: size must be 1..16384 and threads >= 1\n");
+        return 2;
+    }
+    const auto w = make_workload(kind, size);
+    auto target = raster::DepthTarget::create(size, size, raster::DepthFormat::D24);
+    if (!target.ok()) return 1;
+    auto r = raster::execute(target.value(), w->batch, raster::ExecuteOptions{threads, simd});
+    if (!r.ok()) {
+        std::fprintf(stderr, "%s\n", r.error().message.c_str());
+        return 1;
+    }
+    std::printf("%s %d simd=%d threads=%d digest=%016llx\n", argv[2], size, simd ? 1 : 0, threads,
+                static_cast<unsigned long long>(digest(r.value())));
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc >= 5 && std::string(argv[1]) == "--once") return run_once(argc, argv);
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+}

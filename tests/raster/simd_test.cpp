@@ -1,0 +1,289 @@
+// simd_test.cpp: the 8-wide AVX2 GL-exact kernel equals the scalar (portable) kernel bit for bit.
+// White box (raster/src/pipeline.h): random triangles through the real front end, random
+// sub-rectangles (so block-level trivial reject / accept and every partial chunk are hit), random
+// stored depth values (any 32-bit pattern, NaNs for D32F), every format x depth function x mask;
+// then the public API: execute (1, 2, 3, 8 threads, SIMD on) against execute_reference with SIMD
+// off on random scenes, and any-samples early exit against full counts.
+// On a CPU or build without the AVX2 kernel the kernel-level cases compare the fallback with the
+// portable kernel (still a real comparison, and said in a message).
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <vector>
+
+#include "pipeline.h"
+#include "raster/raster.h"
+#include "scene_gen.h"
+
+namespace {
+
+using raster::DepthFormat;
+using raster::DepthFunc;
+namespace detail = raster::detail;
+
+constexpr DepthFunc kFuncs[] = {DepthFunc::Never,   DepthFunc::Less,     DepthFunc::Equal,  DepthFunc::LEqual,
+                                DepthFunc::Greater, DepthFunc::NotEqual, DepthFunc::GEqual, DepthFunc::Always};
+constexpr DepthFormat kFormats[] = {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F};
+
+// A stored depth value: mostly valid for the format, near the triangle's depths so that ties and
+// both outcomes of every compare occur; sometimes an arbitrary bit pattern.
+std::uint32_t random_stored(raster_test::SplitMix64& rng, DepthFormat f, float near_z) {
+    const std::uint32_t pick = rng.below(10);
+    if (pick == 0) return static_cast<std::uint32_t>(rng.next());  // any bits (NaNs for D32F)
+    const float z = std::clamp(near_z + rng.uniform(-0.05f, 0.05f), 0.0f, 1.0f);
+    switch (f) {
+        case DepthFormat::D16: return static_cast<std::uint32_t>(z * 65535.0f) + (rng.chance(50) ? 1u : 0u);
+        case DepthFormat::D24: return static_cast<std::uint32_t>(z * 16777215.0f) + (rng.chance(50) ? 1u : 0u);
+        case DepthFormat::D32F: return std::bit_cast<std::uint32_t>(z);
+    }
+    return 0;
+}
+
+}  // namespace
+
+TEST_CASE("AVX2 kernel == portable kernel on random triangles, rectangles and stored depths (every format, function, mask)") {
+    if (!detail::kernel_avx2_available())
+        MESSAGE("no AVX2+FMA kernel on this CPU/build: comparing the fallback build with the portable one");
+    raster_test::SplitMix64 rng(0x5eed51u);
+    const int sizes[][2] = {{64, 64}, {203, 131}, {257, 67}, {13, 9}};
+    std::uint64_t total_passed = 0, compared = 0, rejected_rects = 0;
+    for (const auto& sz : sizes) {
+        const int w = sz[0], h = sz[1];
+        detail::FrontEndParams p{};
+        p.target_width = w;
+        p.target_height = h;
+        p.viewport = raster::Viewport{0, 0, w, h};
+        p.cull_face = raster::CullFace::None;
+        p.front_face = raster::FrontFace::CCW;
+        for (int n = 0; n < 220; ++n) {
+            std::vector<detail::SetupTri> tris;
+            const int flavour = static_cast<int>(rng.below(5));
+            raster::Float4 v[3];
+            for (auto& x : v) x = raster_test::random_vertex(rng, w, h, flavour);
+            if (rng.chance(30)) {  // large: a corner anywhere, others far away (whole-tile accepts)
+                v[1] = {rng.uniform(-3.0f, 3.0f), rng.uniform(-3.0f, 3.0f), rng.uniform(-0.9f, 0.9f), 1.0f};
+                v[2] = {rng.uniform(-3.0f, 3.0f), rng.uniform(-3.0f, 3.0f), rng.uniform(-0.9f, 0.9f), 1.0f};
+            }
+            detail::setup_triangle(p, v[0], v[1], v[2], 0, tris);
+            for (const auto& t : tris) {
+                // The whole box, and a random sub-rectangle of it.
+                for (int sub = 0; sub < 2; ++sub) {
+                    int rx0 = t.x0, ry0 = t.y0, rx1 = t.x1, ry1 = t.y1;
+                    if (sub == 1) {
+                        rx0 = t.x0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(t.x1 - t.x0 + 1)));
+                        rx1 = rx0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(t.x1 - rx0 + 1)));
+                        ry0 = t.y0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(t.y1 - t.y0 + 1)));
+                        ry1 = ry0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(t.y1 - ry0 + 1)));
+                    }
+                    if (detail::rect_outside(t, rx0, ry0, rx1, ry1)) ++rejected_rects;
+                    const DepthFormat f = kFormats[rng.below(3)];
+                    const DepthFunc func = kFuncs[rng.below(8)];
+                    const bool write = rng.chance(50);
+                    std::vector<std::uint32_t> base(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+                    const float near_z = std::clamp(t.z0 + t.dzdx * static_cast<float>(rx0) +
+                                                        t.dzdy * static_cast<float>(ry0), 0.0f, 1.0f);
+                    for (auto& x : base) x = random_stored(rng, f, near_z);
+                    auto a = base, b = base;
+                    CAPTURE(w);
+                    CAPTURE(static_cast<int>(f));
+                    CAPTURE(static_cast<int>(func));
+                    CAPTURE(write);
+                    const std::uint64_t na =
+                        detail::raster_rect_portable(t, f, func, write, a.data(), w, rx0, ry0, rx1, ry1, false);
+                    const std::uint64_t nb =
+                        detail::raster_rect_avx2(t, f, func, write, b.data(), w, rx0, ry0, rx1, ry1, false);
+                    CHECK(na == nb);
+                    REQUIRE(a == b);  // every depth value, including pixels outside the rectangle
+                    // Early exit: > 0 exactly when the full count is > 0, on both kernels.
+                    auto c = base, d = base;
+                    const std::uint64_t sa = detail::raster_rect_portable(t, f, func, false, c.data(), w, rx0, ry0,
+                                                                          rx1, ry1, true);
+                    const std::uint64_t sb =
+                        detail::raster_rect_avx2(t, f, func, false, d.data(), w, rx0, ry0, rx1, ry1, true);
+                    std::vector<std::uint32_t> e = base;
+                    const std::uint64_t full =
+                        detail::raster_rect_portable(t, f, func, false, e.data(), w, rx0, ry0, rx1, ry1, false);
+                    CHECK((sa > 0) == (full > 0));
+                    CHECK((sb > 0) == (full > 0));
+                    CHECK(sa <= full);
+                    CHECK(sb <= full);
+                    CHECK(c == base);
+                    CHECK(d == base);
+                    total_passed += na;
+                    ++compared;
+                }
+            }
+        }
+    }
+    MESSAGE("rectangles compared: " << compared << ", samples passed: " << total_passed
+                                    << ", rectangles trivially rejected: " << rejected_rects);
+    CHECK(compared > 1000);
+    CHECK(total_passed > 10000);
+    CHECK(rejected_rects > 0);
+}
+
+TEST_CASE("rect_outside never rejects a rectangle with a covered pixel") {
+    raster_test::SplitMix64 rng(4242);
+    detail::FrontEndParams p{};
+    p.target_width = 150;
+    p.target_height = 140;
+    p.viewport = raster::Viewport{0, 0, 150, 140};
+    std::uint64_t rejected = 0;
+    for (int n = 0; n < 3000; ++n) {
+        std::vector<detail::SetupTri> tris;
+        raster::Float4 v[3];
+        for (auto& x : v) x = raster_test::random_vertex(rng, 150, 140, static_cast<int>(rng.below(5)));
+        detail::setup_triangle(p, v[0], v[1], v[2], 0, tris);
+        for (const auto& t : tris) {
+            const int rx0 = t.x0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(t.x1 - t.x0 + 1)));
+            const int ry0 = t.y0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(t.y1 - t.y0 + 1)));
+            const int rx1 = rx0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(t.x1 - rx0 + 1)));
+            const int ry1 = ry0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(t.y1 - ry0 + 1)));
+            if (!detail::rect_outside(t, rx0, ry0, rx1, ry1)) continue;
+            ++rejected;
+            std::vector<std::uint32_t> buf(150u * 140u, 0xffffffu);
+            CHECK(detail::raster_rect_portable(t, DepthFormat::D24, DepthFunc::Always, false, buf.data(), 150, rx0,
+                                               ry0, rx1, ry1, false) == 0);
+        }
+    }
+    CHECK(rejected > 100);
+}
+
+TEST_CASE("execute with SIMD on (1, 2, 3, 8 threads) == execute_reference with SIMD off, every bit") {
+    raster_test::SplitMix64 rng(31337);
+    const int sizes[][2] = {{64, 64}, {250, 170}, {333, 77}};
+    for (const auto f : kFormats) {
+        for (const auto& sz : sizes) {
+            for (int rep = 0; rep < 3; ++rep) {
+                raster_test::Scene scene;
+                raster_test::SceneOptions o;
+                o.width = sz[0];
+                o.height = sz[1];
+                o.objects = 150;
+                raster_test::build_scene(scene, rng, o);
+                auto ref = raster::DepthTarget::create(sz[0], sz[1], f).value();
+                REQUIRE(ref.clear(scene.clear_depth).ok());
+                auto want = raster::execute_reference(ref, scene.batch, raster::ExecuteOptions{1, false});
+                REQUIRE(want.ok());
+                for (const int threads : {1, 2, 3, 8}) {
+                    CAPTURE(static_cast<int>(f));
+                    CAPTURE(sz[0]);
+                    CAPTURE(threads);
+                    auto t = raster::DepthTarget::create(sz[0], sz[1], f).value();
+                    REQUIRE(t.clear(scene.clear_depth).ok());
+                    auto got = raster::execute(t, scene.batch, raster::ExecuteOptions{threads, true});
+                    REQUIRE(got.ok());
+                    CHECK(got.value() == want.value());
+                    const auto va = ref.values(), vb = t.values();
+                    CHECK(std::equal(va.begin(), va.end(), vb.begin(), vb.end()));
+                }
+            }
+        }
+    }
+}
+
+TEST_CASE("any-samples queries (early exit) agree with samples-passed counts, any thread count") {
+    raster_test::SplitMix64 rng(777);
+    for (int rep = 0; rep < 6; ++rep) {
+        // The same geometry twice: once with every query counting, once with every query any-samples.
+        std::vector<std::vector<raster::Float4>> meshes;
+        std::vector<std::uint32_t> idx;
+        const int size = 200;
+        const int objects = 120;
+        for (int k = 0; k < objects * 6; ++k) idx.push_back(static_cast<std::uint32_t>(k));
+        for (int o = 0; o < objects; ++o) {
+            auto& m = meshes.emplace_back();
+            const int flavour = static_cast<int>(rng.below(5));
+            for (int k = 0; k < 6; ++k) m.push_back(raster_test::random_vertex(rng, size, size, flavour));
+        }
+        raster::CommandBatch counts(size, size), any(size, size);
+        for (int o = 0; o < objects; ++o) {
+            const raster::MeshView m{meshes[static_cast<std::size_t>(o)], std::span<const std::uint32_t>(idx.data(), 6)};
+            raster::DrawState q;
+            q.depth_func = rng.chance(50) ? DepthFunc::GEqual : DepthFunc::Less;
+            q.depth_write = false;
+            raster::DrawState d;
+            d.depth_func = DepthFunc::LEqual;
+            for (auto* b : {&counts, &any}) {
+                b->begin_query(b == &counts ? raster::QueryKind::SamplesPassed : raster::QueryKind::AnySamplesPassed);
+                b->draw(m, q);
+                b->draw(m, q);  // a second draw in the same query: skipped once answered
+                b->end_query();
+                b->draw(m, d);
+            }
+        }
+        auto t0 = raster::DepthTarget::create(size, size, DepthFormat::D24).value();
+        auto full = raster::execute_reference(t0, counts, raster::ExecuteOptions{1, false});
+        REQUIRE(full.ok());
+        std::size_t nonzero = 0;
+        for (auto v : full.value()) nonzero += v > 0 ? 1 : 0;
+        CHECK(nonzero > 0);
+        CHECK(nonzero < full.value().size());
+        for (const int threads : {1, 2, 3, 8}) {
+            for (const bool simd : {false, true}) {
+                CAPTURE(threads);
+                CAPTURE(simd);
+                auto t = raster::DepthTarget::create(size, size, DepthFormat::D24).value();
+                auto got = raster::execute(t, any, raster::ExecuteOptions{threads, simd});
+                REQUIRE(got.ok());
+                REQUIRE(got.value().size() == full.value().size());
+                for (std::size_t q = 0; q < full.value().size(); ++q)
+                    CHECK(got.value()[q] == (full.value()[q] > 0 ? 1u : 0u));
+                const auto va = t0.values(), vb = t.values();
+                CHECK(std::equal(va.begin(), va.end(), vb.begin(), vb.end()));
+            }
+        }
+    }
+}
+
+TEST_CASE("one big draw (split front end) and many-tile triangles: any thread count == reference") {
+    raster_test::SplitMix64 rng(99991);
+    const int size = 300;
+    for (const int kind : {0, 1}) {
+        // kind 0: 9000 small triangles in one draw (front end split in pieces with threads > 1);
+        // kind 1: 300 large triangles in one draw (tile-level trivial reject in binning).
+        std::vector<raster::Float4> v;
+        std::vector<std::uint32_t> idx;
+        const int count = kind == 0 ? 9000 : 300;
+        const float r = kind == 0 ? 0.03f : 1.5f;
+        for (int t = 0; t < count; ++t) {
+            const float cx = rng.uniform(-1.1f, 1.1f), cy = rng.uniform(-1.1f, 1.1f);
+            for (int k = 0; k < 3; ++k) {
+                idx.push_back(static_cast<std::uint32_t>(v.size()));
+                v.push_back({cx + rng.uniform(-r, r), cy + rng.uniform(-r, r), rng.uniform(-1.1f, 1.1f), 1.0f});
+            }
+        }
+        raster::CommandBatch batch(size, size);
+        raster::DrawState s;
+        s.depth_func = DepthFunc::LEqual;
+        batch.begin_query(raster::QueryKind::SamplesPassed);
+        batch.draw({v, idx}, s);
+        batch.end_query();
+        raster::DrawState q;
+        q.depth_func = DepthFunc::Equal;
+        q.depth_write = false;
+        batch.begin_query(raster::QueryKind::SamplesPassed);
+        batch.draw({v, idx}, q);
+        batch.end_query();
+        for (const auto f : kFormats) {
+            auto ref = raster::DepthTarget::create(size, size, f).value();
+            auto want = raster::execute_reference(ref, batch, raster::ExecuteOptions{1, false});
+            REQUIRE(want.ok());
+            CHECK(want.value()[0] > 0);
+            CHECK(want.value()[1] > 0);
+            for (const int threads : {1, 2, 3, 8}) {
+                CAPTURE(kind);
+                CAPTURE(static_cast<int>(f));
+                CAPTURE(threads);
+                auto t = raster::DepthTarget::create(size, size, f).value();
+                auto got = raster::execute(t, batch, raster::ExecuteOptions{threads, true});
+                REQUIRE(got.ok());
+                CHECK(got.value() == want.value());
+                const auto va = ref.values(), vb = t.values();
+                CHECK(std::equal(va.begin(), va.end(), vb.begin(), vb.end()));
+            }
+        }
+    }
+}
