@@ -10,10 +10,6 @@
 namespace raster::detail {
 namespace {
 
-struct P3 {
-    double v[3];
-};
-
 // Sutherland-Hodgman against the closed half-space s * p[axis] <= bound (s = +1 or -1): keeps the
 // points with d = bound - s * p[axis] >= 0. A point or a segment (degenerate input) goes through the
 // same loop and stays a point or a segment. New points lie on the edge between the two points they
@@ -23,11 +19,13 @@ struct P3 {
 // computed polygon very slightly non-convex; should the output ever not fit kBoundsMaxVerts, the
 // input is returned unclipped: a superset, so still conservative (the margins are sized from the
 // input magnitude, so they hold for unclipped coordinates too).
-int clip_axis(const P3* in, int n, P3* out, int axis, double s, double bound) {
+}  // namespace
+
+int bounds_clip_axis(const BoundsP3* in, int n, BoundsP3* out, int axis, double s, double bound) {
     int m = 0;
     for (int i = 0; i < n; ++i) {
-        const P3& cur = in[i];
-        const P3& nxt = in[(i + 1) % n];
+        const BoundsP3& cur = in[i];
+        const BoundsP3& nxt = in[i + 1 == n ? 0 : i + 1];
         const double dc = bound - s * cur.v[axis];
         const double dn = bound - s * nxt.v[axis];
         if (m + 2 > kBoundsMaxVerts) {
@@ -37,13 +35,15 @@ int clip_axis(const P3* in, int n, P3* out, int axis, double s, double bound) {
         if (dc >= 0.0) out[m++] = cur;
         if ((dc >= 0.0) != (dn >= 0.0)) {
             const double t = dc / (dc - dn);
-            P3 p{};
+            BoundsP3 p{};
             for (int k = 0; k < 3; ++k) p.v[k] = cur.v[k] + t * (nxt.v[k] - cur.v[k]);
             out[m++] = p;
         }
     }
     return m;
 }
+
+namespace {
 
 // 2^-k as a constant.
 constexpr double pow2m(int k) {
@@ -58,6 +58,19 @@ constexpr double kPixelMargin = pow2m(20);    // pixels, for the window-space st
 constexpr double kDepthMargin = pow2m(40);    // window depth, for the window-space steps
 
 constexpr double kFracGuard = pow2m(27);  // > 2^-29, the rounding error of z * n for n < 2^24
+
+// floor and ceil without a libm call on baseline x86-64 (equal to std::floor / std::ceil for every
+// finite x, up to the sign of a zero result: |x| >= 2^52 is already an integer).
+double exact_floor(double x) {
+    if (!(std::fabs(x) < 0x1p52)) return x;
+    const double t = static_cast<double>(static_cast<std::int64_t>(x));
+    return t > x ? t - 1.0 : t;
+}
+double exact_ceil(double x) {
+    if (!(std::fabs(x) < 0x1p52)) return x;
+    const double t = static_cast<double>(static_cast<std::int64_t>(x));
+    return t < x ? t + 1.0 : t;
+}
 
 std::uint32_t unorm_max(DepthFormat f) { return f == DepthFormat::D16 ? 0xffffu : 0xffffffu; }
 
@@ -117,17 +130,28 @@ void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const
 
     // Clip against the clip volume grown by mc (closed), in clip space: afterwards every coordinate
     // is within [-lim, lim] up to rounding, whatever the input magnitude.
-    P3 buf_a[kBoundsMaxVerts];
-    P3 buf_b[kBoundsMaxVerts];
+    BoundsP3 buf_a[kBoundsMaxVerts];
+    BoundsP3 buf_b[kBoundsMaxVerts];
     buf_a[0] = {{a.x, a.y, a.z}};
     buf_a[1] = {{b.x, b.y, b.z}};
     buf_a[2] = {{c.x, c.y, c.z}};
     int n = 3;
-    P3* cur = buf_a;
-    P3* nxt = buf_b;
-    for (int axis = 0; axis < 3 && n > 0; ++axis) {
+    BoundsP3* cur = buf_a;
+    BoundsP3* nxt = buf_b;
+    // Trivial accept: a clip that keeps every vertex returns the triangle unchanged (mag >= every
+    // |coordinate|, so only lim's rounding could matter, and the test is the clip's own d >= 0).
+    // (lim - v >= 0 iff v <= lim and lim + v >= 0 iff v >= -lim: the signs of the rounded
+    // differences are the exact ones.)
+    double cmax = cur[0].v[0], cmin = cmax;
+    for (int i = 0; i < 3; ++i)
+        for (int axis = 0; axis < 3; ++axis) {
+            cmax = cur[i].v[axis] > cmax ? cur[i].v[axis] : cmax;
+            cmin = cur[i].v[axis] < cmin ? cur[i].v[axis] : cmin;
+        }
+    const bool inside = cmax <= lim && cmin >= -lim;
+    for (int axis = 0; axis < 3 && n > 0 && !inside; ++axis) {
         for (double s : {1.0, -1.0}) {
-            n = clip_axis(cur, n, nxt, axis, s, lim);
+            n = bounds_clip_axis(cur, n, nxt, axis, s, lim);
             std::swap(cur, nxt);
             if (n == 0) break;
         }
@@ -157,8 +181,8 @@ void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const
     t.draw = draw;
 
     // Closed square [px, px + 1] meets [lo, hi] iff ceil(lo) - 1 <= px <= floor(hi).
-    const double bx0 = std::ceil(minx - t.margin_xy) - 1.0, bx1 = std::floor(maxx + t.margin_xy);
-    const double by0 = std::ceil(miny - t.margin_xy) - 1.0, by1 = std::floor(maxy + t.margin_xy);
+    const double bx0 = exact_ceil(minx - t.margin_xy) - 1.0, bx1 = exact_floor(maxx + t.margin_xy);
+    const double by0 = exact_ceil(miny - t.margin_xy) - 1.0, by1 = exact_floor(maxy + t.margin_xy);
     const double w1 = static_cast<double>(params.target_width - 1),
                  h1 = static_cast<double>(params.target_height - 1);
     if (bx1 < 0.0 || by1 < 0.0 || bx0 > w1 || by0 > h1) return;
@@ -166,6 +190,7 @@ void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const
     t.y0 = static_cast<int>(std::max(by0, 0.0));
     t.x1 = static_cast<int>(std::min(bx1, w1));
     t.y1 = static_cast<int>(std::min(by1, h1));
+    t.single = bx0 == bx1 && by0 == by1;
     t.first = static_cast<std::uint32_t>(pool.size());
     pool.insert(pool.end(), win, win + n);
     out.push_back(t);
@@ -196,103 +221,29 @@ bool depth_pass(DepthFunc f, T incoming, T stored) {
     return false;
 }
 
-// One edge of a row polygon, prepared once per row: its ends and dz/dX (0 when vertical).
-struct RowEdge {
-    double xp, xq, zp, zq, slope, zmin, zmax;
-};
-
-int prepare_row(const P3* poly, int n, RowEdge* edges) {
-    for (int i = 0; i < n; ++i) {
-        const P3& p = poly[i];
-        const P3& q = poly[(i + 1) % n];
-        RowEdge& e = edges[i];
-        e.xp = p.v[0];
-        e.xq = q.v[0];
-        e.zp = p.v[2];
-        e.zq = q.v[2];
-        e.slope = e.xq != e.xp ? (e.zq - e.zp) / (e.xq - e.xp) : 0.0;
-        e.zmin = std::min(e.zp, e.zq);
-        e.zmax = std::max(e.zp, e.zq);
-    }
-    return n;
-}
-
-// The depth range of a convex polygon (possibly a segment or a point) over the slab xl <= X <= xr:
-// a linear function's extremes over polygon-and-slab lie on the polygon's boundary, so it is the
-// range over each edge's part inside the slab, whose ends are the edge's vertices inside the slab
-// and its crossings of the slab's sides. Which edges meet the slab is decided by exact comparisons.
-// A crossing's depth zp + (bound - xp) * slope errs by <= 3 ulp of |zq - zp| <= 2^-50 (the bound
-// lies between xp and xq) and is clamped to the edge's depth range: inside margin_z.
-// Returns false when the polygon misses the slab.
-bool column_range(const RowEdge* edges, int n, double xl, double xr, double& zlo, double& zhi) {
-    bool any = false;
-    zlo = std::numeric_limits<double>::infinity();
-    zhi = -zlo;
-    auto take = [&](double z) {
-        zlo = std::min(zlo, z);
-        zhi = std::max(zhi, z);
-        any = true;
-    };
-    for (int i = 0; i < n; ++i) {
-        const RowEdge& e = edges[i];
-        if ((e.xp < xl && e.xq < xl) || (e.xp > xr && e.xq > xr)) continue;
-        if (e.xp >= xl && e.xp <= xr) take(e.zp);
-        if (e.xq >= xl && e.xq <= xr) take(e.zq);
-        for (const double bound : {xl, xr}) {
-            if ((e.xp < bound && e.xq > bound) || (e.xp > bound && e.xq < bound))
-                take(std::clamp(e.zp + (bound - e.xp) * e.slope, e.zmin, e.zmax));
-        }
-    }
-    return any;
-}
-
 }  // namespace
 
 std::uint64_t bounds_rect(const BoundsTri& tri, const BoundsVertex* pool, DepthFormat format, DepthFunc func,
                           bool write, std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1) {
-    const double m = tri.margin_xy;
-    P3 poly[kBoundsMaxVerts];
-    for (int i = 0; i < tri.n; ++i) {
-        const BoundsVertex& v = pool[tri.first + static_cast<std::uint32_t>(i)];
-        poly[i] = {{v.x, v.y, v.z}};
-    }
     std::uint64_t passed = 0;
-    P3 row_a[kBoundsMaxVerts];
-    P3 row_b[kBoundsMaxVerts];
-    RowEdge edges[kBoundsMaxVerts];
-    for (int py = ry0; py <= ry1; ++py) {
-        // The row's slab first (depends on py only), then each pixel's column.
-        const double fy = static_cast<double>(py);
-        int rn = clip_axis(poly, tri.n, row_a, 1, -1.0, -(fy - m));  // Y >= py - m
-        if (rn == 0) continue;
-        rn = clip_axis(row_a, rn, row_b, 1, 1.0, fy + 1.0 + m);  // Y <= py + 1 + m
-        if (rn == 0) continue;
-        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        for (int i = 0; i < rn; ++i) {
-            lo = std::min(lo, row_b[i].v[0]);
-            hi = std::max(hi, row_b[i].v[0]);
+    const bool d32f = format == DepthFormat::D32F;
+    double last = std::numeric_limits<double>::quiet_NaN();  // quantize once per distinct depth
+    std::uint32_t incoming = 0;
+    bounds_pixels(tri, pool, rx0, ry0, rx1, ry1, [&](int px, int py, double zlo, double zhi) {
+        const double z = write ? zlo : zhi;
+        if (!(z == last)) {
+            last = z;
+            incoming = write ? quantize_down(zlo - tri.margin_z, format) : quantize_up(zhi + tri.margin_z, format);
         }
-        const int xs = std::max(rx0, static_cast<int>(std::max(std::ceil(lo - m) - 1.0, -1.0)));
-        const int xe =
-            std::min(rx1, static_cast<int>(std::min(std::floor(hi + m), static_cast<double>(rx1))));
-        std::uint32_t* row = depth + static_cast<std::size_t>(py) * static_cast<std::size_t>(stride);
-        const int ne = prepare_row(row_b, rn, edges);
-        for (int px = xs; px <= xe; ++px) {
-            const double fx = static_cast<double>(px);
-            double zlo = 0.0, zhi = 0.0;
-            if (!column_range(edges, ne, fx - m, fx + 1.0 + m, zlo, zhi)) continue;
-            const std::uint32_t incoming =
-                write ? quantize_down(zlo - tri.margin_z, format) : quantize_up(zhi + tri.margin_z, format);
-            std::uint32_t& stored = row[px];
-            const bool pass = format == DepthFormat::D32F ? depth_pass(func, std::bit_cast<float>(incoming),
-                                                                       std::bit_cast<float>(stored))
-                                                          : depth_pass(func, incoming, stored);
-            if (pass) {
-                ++passed;
-                if (write) stored = incoming;
-            }
+        std::uint32_t& stored = depth[static_cast<std::size_t>(py) * static_cast<std::size_t>(stride) +
+                                      static_cast<std::size_t>(px)];
+        const bool pass = d32f ? depth_pass(func, std::bit_cast<float>(incoming), std::bit_cast<float>(stored))
+                               : depth_pass(func, incoming, stored);
+        if (pass) {
+            ++passed;
+            if (write) stored = incoming;
         }
-    }
+    });
     return passed;
 }
 

@@ -1,0 +1,64 @@
+// raster/visibility.h: CULLIDE's two visibility passes (Lemma 2) in the exact-bounds mode, fused
+// into one emulator-native pass (docs/reliable-raster.md, "The fused visibility pass").
+//
+// The recorded form (cullide/cullide.h): clear depth to 1; for each object in order, query each of
+// its items (exact-bounds, GEQUAL against the item's zmax, mask off, any-samples), then write them
+// all (exact-bounds, LEQUAL with the zmin, mask on); a second pass does the same in reverse object
+// order. An item is fully visible iff neither of its two queries passes a sample.
+//
+// Fused: the stored depth that a query of object k's item meets at pixel p in pass 1 is
+// min(clear, zmin of every item of objects before k covering p), in pass 2 the same over the
+// objects after k (LEQUAL writes keep the minimum; an object's own writes come after its queries).
+// The item passes a query iff some covered pixel has zmax >= that value, so it passes one of the two
+// iff some covered pixel has zmax >= min(clear, zmin of every item of every OTHER object) (the OR of
+// the two passes, pixel by pixel, since min(A, B) <= z iff A <= z or B <= z). One rasterization per
+// item gives both of its encoded depths per pixel (the very per-pixel values the recorded draws
+// would compute: the same setup, traversal and outward quantization); per pixel the pass keeps the
+// smallest zmin with its object and the smallest zmin of any other object, which is all the test
+// needs. So the answer equals the two-pass answer bit for bit, for any order of the objects, at a
+// quarter of the rasterization (one draw per item instead of four) and without the depth target.
+//
+// Tiled (64 x 64; 16 or 32 on targets up to 128 or 256 pixels, to keep several tasks) and
+// threaded like raster::execute; every tile is computed by one task in a fixed
+// order and the per-item answers are ORs, so the result does not depend on the thread count.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "raster/result.h"
+#include "raster/types.h"
+
+namespace raster {
+
+// One PCS item: its triangles (double clip space, the exact-bounds input rules of
+// CommandBatch::draw(MeshViewD, ...): finite, w = 1, |x|, |y|, |z| <= kMaxExactBoundsCoordinate)
+// and the object it belongs to (items of one object never hide each other).
+struct VisibilityItem {
+    MeshViewD mesh;
+    std::uint32_t object = 0;
+};
+
+// Reusable state (buffers kept between calls, so a pipeline allocates only while they grow).
+class VisibilityPass {
+   public:
+    VisibilityPass();
+    ~VisibilityPass();
+    VisibilityPass(const VisibilityPass&) = delete;
+    VisibilityPass& operator=(const VisibilityPass&) = delete;
+
+    // For each item, 1 when it is NOT fully visible (one of its two recorded queries would pass a
+    // sample), 0 when it is fully visible with respect to every other object's items, on a
+    // width x height target of `format` cleared to 1, in the exact-bounds mode (full viewport). Fails,
+    // naming the item, triangle position and vertex, on invalid input (nothing is computed then).
+    [[nodiscard]] Result<std::vector<std::uint8_t>> run(int width, int height, DepthFormat format,
+                                                        std::span<const VisibilityItem> items, int threads);
+
+   private:
+    struct State;
+    std::unique_ptr<State> s_;
+};
+
+}  // namespace raster

@@ -1,0 +1,239 @@
+// visibility.cpp: the fused exact-bounds visibility pass (raster/visibility.h; the equivalence with
+// the two recorded passes is argued there and in docs/reliable-raster.md).
+#include "raster/visibility.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "exact_bounds.h"
+#include "pipeline.h"
+#include "raster/depth_target.h"
+
+#if defined(CULLIDE_HAVE_TBB)
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+#endif
+
+namespace raster {
+namespace {
+
+// Tile side: 64 like raster::execute, but smaller on small targets so that CULLIDE's low-resolution
+// views still split into several tasks (the answer does not depend on it: every pixel's minima and
+// every fragment's test are the same whichever tile holds them).
+int tile_side(int width, int height) {
+    const int m = std::max(width, height);
+    return m <= 128 ? 16 : m <= 256 ? 32 : 64;
+}
+constexpr std::uint32_t kNoObject = 0xffffffffu;
+
+template <class F>
+void for_each_parallel(int threads, std::size_t n, const F& body) {
+#if defined(CULLIDE_HAVE_TBB)
+    if (threads > 1 && n > 1) {
+        oneapi::tbb::task_arena arena(threads);
+        arena.execute([&] {
+            oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, n, 1),
+                                      [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
+                                          for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
+                                      });
+        });
+        return;
+    }
+#else
+    (void)threads;
+#endif
+    for (std::size_t i = 0; i < n; ++i) body(i);
+}
+
+std::string check_vertex(const Double4& d) {
+    if (!std::isfinite(d.x) || !std::isfinite(d.y) || !std::isfinite(d.z) || !std::isfinite(d.w))
+        return "is not finite";
+    if (d.w != 1.0) return "has w = " + std::to_string(d.w) + " (the exact-bounds mode takes orthographic input, w = 1)";
+    if (std::fabs(d.x) > kMaxExactBoundsCoordinate || std::fabs(d.y) > kMaxExactBoundsCoordinate ||
+        std::fabs(d.z) > kMaxExactBoundsCoordinate)
+        return "has a coordinate beyond +-2^100 (kMaxExactBoundsCoordinate)";
+    return {};
+}
+
+// Encoded depths compare as unsigned integers in every format: unorm values directly, and D32F
+// values are the bits of floats in [+0, 1] (quantize_down/up clamp to [0, 1] and never return
+// -0), whose order is the integer order of their bits.
+struct Fragment {
+    std::uint32_t item;
+    std::uint32_t pixel;  // index inside the tile
+    std::uint32_t zmax;   // encoded, rounded up: the query's incoming value
+};
+
+struct Ref {
+    std::uint32_t item;
+    std::uint32_t tri;
+};
+
+}  // namespace
+
+struct VisibilityPass::State {
+    std::vector<std::vector<detail::BoundsTri>> tris;     // per item
+    std::vector<std::vector<detail::BoundsVertex>> pool;  // per item
+    std::vector<std::vector<Ref>> bins;                   // per tile
+    std::vector<std::vector<Fragment>> frags;             // per tile (scratch)
+    std::vector<std::vector<std::uint32_t>> hits;         // per tile: items found not fully visible
+    std::vector<std::uint32_t> min1, obj1, min2;          // per pixel, tile-major (one tile = side^2)
+};
+
+VisibilityPass::VisibilityPass() : s_(std::make_unique<State>()) {}
+VisibilityPass::~VisibilityPass() = default;
+
+Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, DepthFormat format,
+                                                      std::span<const VisibilityItem> items, int threads) {
+    if (width < 1 || height < 1 || width > kMaxTargetSize || height > kMaxTargetSize)
+        return Error{"visibility pass: target " + std::to_string(width) + "x" + std::to_string(height) +
+                     " is outside 1.." + std::to_string(kMaxTargetSize) + " per side"};
+    if (format != DepthFormat::D16 && format != DepthFormat::D24 && format != DepthFormat::D32F)
+        return Error{"visibility pass: invalid depth format"};
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        const MeshViewD& m = items[i].mesh;
+        if (m.indices.size() % 3 != 0)
+            return Error{"visibility pass: item " + std::to_string(i) + ": index count " +
+                         std::to_string(m.indices.size()) + " is not a multiple of 3"};
+        for (std::size_t k = 0; k < m.indices.size(); ++k) {
+            if (m.indices[k] >= m.vertices.size())
+                return Error{"visibility pass: item " + std::to_string(i) + ": index " + std::to_string(m.indices[k]) +
+                             " at position " + std::to_string(k) + " is beyond the vertex list (size " +
+                             std::to_string(m.vertices.size()) + ")"};
+            const Double4& d = m.vertices[m.indices[k]];
+            const bool ok = d.w == 1.0 && std::fabs(d.x) <= kMaxExactBoundsCoordinate &&
+                            std::fabs(d.y) <= kMaxExactBoundsCoordinate &&
+                            std::fabs(d.z) <= kMaxExactBoundsCoordinate;  // false for NaN too
+            if (ok) continue;
+            if (std::string why = check_vertex(d); !why.empty())
+                return Error{"visibility pass: item " + std::to_string(i) + ": vertex " +
+                             std::to_string(m.indices[k]) + " " + why};
+        }
+    }
+    if (items.size() >= kNoObject) return Error{"visibility pass: too many items (limit 2^32 - 1)"};
+    threads = std::max(1, threads);
+    State& s = *s_;
+
+    // Front end per item (the recorded draws' own setup, so the same polygons).
+    if (s.tris.size() < items.size()) {
+        s.tris.resize(items.size());
+        s.pool.resize(items.size());
+    }
+    detail::FrontEndParams params{};
+    params.target_width = width;
+    params.target_height = height;
+    params.viewport = Viewport{0, 0, width, height};
+    params.cull_face = CullFace::None;
+    params.front_face = FrontFace::CCW;
+    for_each_parallel(threads, items.size(), [&](std::size_t i) {
+        auto& tris = s.tris[i];
+        auto& pool = s.pool[i];
+        tris.clear();
+        pool.clear();
+        const MeshViewD& m = items[i].mesh;
+        for (std::size_t k = 0; k + 2 < m.indices.size(); k += 3)
+            detail::setup_bounds_triangle(params, m.vertices[m.indices[k]], m.vertices[m.indices[k + 1]],
+                                          m.vertices[m.indices[k + 2]], static_cast<std::uint32_t>(i), tris, pool);
+    });
+
+    // Binning, in item order.
+    const int kTile = tile_side(width, height);
+    const int tiles_x = (width + kTile - 1) / kTile;
+    const int tiles_y = (height + kTile - 1) / kTile;
+    const std::size_t tile_count = static_cast<std::size_t>(tiles_x) * static_cast<std::size_t>(tiles_y);
+    if (s.bins.size() < tile_count) {
+        s.bins.resize(tile_count);
+        s.frags.resize(tile_count);
+        s.hits.resize(tile_count);
+    }
+    for (std::size_t t = 0; t < tile_count; ++t) s.bins[t].clear();
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        for (std::size_t k = 0; k < s.tris[i].size(); ++k) {
+            const detail::BoundsTri& t = s.tris[i][k];
+            for (int ty = t.y0 / kTile; ty <= t.y1 / kTile; ++ty)
+                for (int tx = t.x0 / kTile; tx <= t.x1 / kTile; ++tx)
+                    s.bins[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x) +
+                           static_cast<std::size_t>(tx)]
+                        .push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)});
+        }
+    }
+    const std::size_t tile_pixels = static_cast<std::size_t>(kTile) * static_cast<std::size_t>(kTile);
+    if (s.min1.size() < tile_count * tile_pixels) {
+        s.min1.resize(tile_count * tile_pixels);
+        s.obj1.resize(tile_count * tile_pixels);
+        s.min2.resize(tile_count * tile_pixels);
+    }
+    const std::uint32_t clear = DepthTarget::encode_clear(1.0, format);
+
+    // Per tile: every fragment's zmin into the two minima, then every fragment's zmax against the
+    // minimum over the other objects.
+    for_each_parallel(threads, tile_count, [&](std::size_t tile) {
+        auto& bin = s.bins[tile];
+        auto& frags = s.frags[tile];
+        auto& hits = s.hits[tile];
+        frags.clear();
+        hits.clear();
+        if (bin.empty()) return;
+        const int tx = static_cast<int>(tile % static_cast<std::size_t>(tiles_x));
+        const int ty = static_cast<int>(tile / static_cast<std::size_t>(tiles_x));
+        const int x0 = tx * kTile, y0 = ty * kTile;
+        const int x1 = std::min(x0 + kTile, width) - 1, y1 = std::min(y0 + kTile, height) - 1;
+        std::uint32_t* min1 = s.min1.data() + tile * tile_pixels;
+        std::uint32_t* obj1 = s.obj1.data() + tile * tile_pixels;
+        std::uint32_t* min2 = s.min2.data() + tile * tile_pixels;
+        std::fill(min1, min1 + tile_pixels, clear);
+        std::fill(obj1, obj1 + tile_pixels, kNoObject);
+        std::fill(min2, min2 + tile_pixels, clear);
+        for (const Ref& r : bin) {
+            const detail::BoundsTri& t = s.tris[r.item][r.tri];
+            const std::uint32_t obj = items[r.item].object;
+            const double mz = t.margin_z;
+            double last_lo = std::numeric_limits<double>::quiet_NaN(), last_hi = last_lo;
+            std::uint32_t zmin = 0, zmax = 0;  // quantized once per distinct depth
+            detail::bounds_pixels(t, s.pool[r.item].data(), std::max(x0, t.x0), std::max(y0, t.y0),
+                                  std::min(x1, t.x1), std::min(y1, t.y1), [&](int px, int py, double zlo, double zhi) {
+                                      const auto p = static_cast<std::uint32_t>((py - y0) * kTile + (px - x0));
+                                      if (!(zlo == last_lo)) {
+                                          last_lo = zlo;
+                                          zmin = detail::quantize_down(zlo - mz, format);
+                                      }
+                                      if (!(zhi == last_hi)) {
+                                          last_hi = zhi;
+                                          zmax = detail::quantize_up(zhi + mz, format);
+                                      }
+                                      if (obj == obj1[p]) {
+                                          min1[p] = std::min(min1[p], zmin);
+                                      } else if (zmin < min1[p]) {
+                                          min2[p] = min1[p];
+                                          min1[p] = zmin;
+                                          obj1[p] = obj;
+                                      } else {
+                                          min2[p] = std::min(min2[p], zmin);
+                                      }
+                                      frags.push_back({r.item, p, zmax});
+                                  });
+        }
+        // min1 is the minimum over all objects (with the clear value) and min2 the minimum over
+        // the objects other than obj1's, so the minimum over the objects other than o is min2 when
+        // o is obj1 and min1 otherwise (ties between objects: then min2 == min1).
+        std::uint32_t last = kNoObject;
+        for (const Fragment& f : frags) {
+            if (f.item == last) continue;
+            const std::uint32_t other = items[f.item].object == obj1[f.pixel] ? min2[f.pixel] : min1[f.pixel];
+            if (f.zmax >= other) {  // the GEQUAL query passes here
+                hits.push_back(f.item);
+                last = f.item;
+            }
+        }
+    });
+
+    std::vector<std::uint8_t> result(items.size(), 0);
+    for (std::size_t t = 0; t < tile_count; ++t)
+        for (const std::uint32_t i : s.hits[t]) result[i] = 1;
+    return result;
+}
+
+}  // namespace raster

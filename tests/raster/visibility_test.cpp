@@ -1,0 +1,193 @@
+// visibility_test.cpp: raster::VisibilityPass (the fused exact-bounds visibility pass) against the
+// two recorded passes it replaces (raster/visibility.h): on random scenes of objects made of items
+// (including degenerate, flat, edge-on, out-of-volume and sub-pixel triangles, and objects covering
+// the same pixels at the same depth), for every depth format, several target sizes (one tile and
+// several, edges not on tile borders) and 1, 2, 3 and 8 threads, the per-item answer equals "one of
+// the item's two queries passed a sample" from raster::execute and raster::execute_reference.
+#include <doctest/doctest.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "raster/raster.h"
+#include "raster/visibility.h"
+#include "test_rng.h"
+
+namespace {
+
+using raster::DepthFormat;
+using raster::Double4;
+
+struct Scene {
+    std::vector<Double4> vertices;
+    std::vector<std::vector<std::uint32_t>> item_indices;
+    std::vector<std::uint32_t> item_object;  // non-decreasing: items of one object are consecutive
+    std::uint32_t objects = 0;
+};
+
+Double4 vertex_near(test::Rng& rng, const Double4& c, double r, bool flat) {
+    return {c.x + rng.uniform(-r, r), c.y + rng.uniform(-r, r), flat ? c.z : c.z + rng.uniform(-r, r), 1.0};
+}
+
+Scene random_scene(test::Rng& rng, int objects) {
+    Scene s;
+    s.objects = static_cast<std::uint32_t>(objects);
+    // A shared depth for some flat triangles, so that different objects tie exactly.
+    const double tie_z = rng.uniform(-0.5, 0.5);
+    for (int o = 0; o < objects; ++o) {
+        const int items = 1 + static_cast<int>(rng.below(3));
+        const Double4 centre{rng.uniform(-0.9, 0.9), rng.uniform(-0.9, 0.9), rng.uniform(-0.9, 0.9), 1.0};
+        for (int it = 0; it < items; ++it) {
+            std::vector<std::uint32_t> idx;
+            const int tris = 1 + static_cast<int>(rng.below(4));
+            for (int t = 0; t < tris; ++t) {
+                const auto base = static_cast<std::uint32_t>(s.vertices.size());
+                const int kind = static_cast<int>(rng.below(6));
+                const double r = kind == 0 ? 0.6 : kind == 1 ? 0.01 : 0.2;  // large, sub-pixel, medium
+                Double4 a = vertex_near(rng, centre, r, false);
+                if (kind == 2) a.z = tie_z;
+                Double4 b = vertex_near(rng, a, r, kind == 2);
+                Double4 c = vertex_near(rng, a, r, kind == 2);
+                if (kind == 3) {  // edge-on: all three on one vertical line of the window
+                    b.x = c.x = a.x;
+                    b.y = a.y;
+                    c.y = a.y;
+                }
+                if (kind == 4) {  // degenerate: a segment, or a point
+                    c = rng.below(2) == 0 ? a : b;
+                }
+                if (kind == 5) {  // partly outside the clip volume
+                    b.x += 1.5;
+                    c.z -= 1.5;
+                }
+                s.vertices.push_back(a);
+                s.vertices.push_back(b);
+                s.vertices.push_back(c);
+                idx.insert(idx.end(), {base, base + 1, base + 2});
+            }
+            s.item_indices.push_back(std::move(idx));
+            s.item_object.push_back(static_cast<std::uint32_t>(o));
+        }
+    }
+    return s;
+}
+
+// The two passes as cullide.cpp records them: per object, query each item (GEQUAL, mask off), then
+// write them (LEQUAL, mask on); pass 2 in reverse object order. Returns per item "a query passed".
+std::vector<std::uint8_t> recorded(const Scene& s, int w, int h, DepthFormat f, int threads, bool reference) {
+    std::vector<std::uint8_t> any(s.item_indices.size(), 0);
+    for (int pass = 0; pass < 2; ++pass) {
+        raster::CommandBatch batch(w, h);
+        std::vector<std::uint32_t> query_item;
+        for (std::uint32_t k = 0; k < s.objects; ++k) {
+            const std::uint32_t o = pass == 0 ? k : s.objects - 1 - k;
+            raster::DrawState q;
+            q.mode = raster::RasterMode::ExactBounds;
+            q.depth_func = raster::DepthFunc::GEqual;
+            q.depth_write = false;
+            raster::DrawState d = q;
+            d.depth_func = raster::DepthFunc::LEqual;
+            d.depth_write = true;
+            for (std::size_t i = 0; i < s.item_indices.size(); ++i) {
+                if (s.item_object[i] != o) continue;
+                batch.begin_query(raster::QueryKind::AnySamplesPassed);
+                batch.draw(raster::MeshViewD{s.vertices, s.item_indices[i]}, q);
+                batch.end_query();
+                query_item.push_back(static_cast<std::uint32_t>(i));
+            }
+            for (std::size_t i = 0; i < s.item_indices.size(); ++i)
+                if (s.item_object[i] == o) batch.draw(raster::MeshViewD{s.vertices, s.item_indices[i]}, d);
+        }
+        auto target = raster::DepthTarget::create(w, h, f);
+        REQUIRE(target.ok());
+        auto r = reference ? raster::execute_reference(target.value(), batch, raster::ExecuteOptions{1})
+                           : raster::execute(target.value(), batch, raster::ExecuteOptions{threads});
+        REQUIRE_MESSAGE(r.ok(), r.error().message);
+        for (std::size_t q = 0; q < query_item.size(); ++q)
+            if (r.value()[q] != 0) any[query_item[q]] = 1;
+    }
+    return any;
+}
+
+std::vector<raster::VisibilityItem> items_of(const Scene& s) {
+    std::vector<raster::VisibilityItem> items;
+    for (std::size_t i = 0; i < s.item_indices.size(); ++i)
+        items.push_back({raster::MeshViewD{s.vertices, s.item_indices[i]}, s.item_object[i]});
+    return items;
+}
+
+}  // namespace
+
+TEST_CASE("The fused visibility pass gives the two recorded passes' answers, any format, size and thread count") {
+    test::Rng rng(20261121);
+    const DepthFormat formats[] = {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F};
+    const int sizes[][2] = {{16, 16}, {37, 23}, {130, 70}};
+    raster::VisibilityPass pass;  // reused across calls, as the pipeline does
+    int visible = 0, hidden = 0;
+    for (int rep = 0; rep < 120; ++rep) {
+        const Scene s = random_scene(rng, 2 + static_cast<int>(rng.below(12)));
+        const DepthFormat f = formats[rep % 3];
+        const int w = sizes[(rep / 3) % 3][0], h = sizes[(rep / 3) % 3][1];
+        CAPTURE(rep);
+        const std::vector<std::uint8_t> want = recorded(s, w, h, f, 1, true);
+        CHECK(recorded(s, w, h, f, 3, false) == want);
+        for (const int threads : {1, 2, 3, 8}) {
+            CAPTURE(threads);
+            auto got = pass.run(w, h, f, items_of(s), threads);
+            REQUIRE_MESSAGE(got.ok(), got.error().message);
+            CHECK(got.value() == want);
+        }
+        for (auto v : want) (v != 0 ? hidden : visible) += 1;
+    }
+    // Both answers occur, so the comparison can fail either way.
+    CHECK(visible > 20);
+    CHECK(hidden > 20);
+}
+
+TEST_CASE("The fused visibility pass: an item exactly at another object's depth is not fully visible") {
+    // Two objects, one flat triangle each at the same depth: GEQUAL passes on equal values, so
+    // neither is fully visible; with the second moved back, the first (nearer) is, the second not.
+    for (const DepthFormat f : {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F}) {
+        CAPTURE(static_cast<int>(f));
+        for (const double dz : {0.0, 0.25}) {
+            const std::vector<Double4> v = {{-0.5, -0.5, 0.0, 1}, {0.5, -0.5, 0.0, 1}, {0.5, 0.5, 0.0, 1},
+                                            {-0.5, -0.5, dz, 1},  {0.5, -0.5, dz, 1},  {0.5, 0.5, dz, 1}};
+            const std::vector<std::uint32_t> a = {0, 1, 2}, b = {3, 4, 5};
+            const std::vector<raster::VisibilityItem> items = {{raster::MeshViewD{v, a}, 0},
+                                                               {raster::MeshViewD{v, b}, 1}};
+            raster::VisibilityPass pass;
+            auto r = pass.run(32, 32, f, items, 2);
+            REQUIRE(r.ok());
+            CHECK(r.value()[0] == (dz == 0.0 ? 1 : 0));
+            CHECK(r.value()[1] == 1);
+            // Items of one object never hide each other.
+            const std::vector<raster::VisibilityItem> same = {{raster::MeshViewD{v, a}, 7},
+                                                              {raster::MeshViewD{v, b}, 7}};
+            auto r2 = pass.run(32, 32, f, same, 2);
+            REQUIRE(r2.ok());
+            CHECK(r2.value() == std::vector<std::uint8_t>{0, 0});
+        }
+    }
+}
+
+TEST_CASE("The fused visibility pass rejects bad input, naming the item and vertex") {
+    const std::vector<Double4> v = {{0, 0, 0, 1}, {0.5, 0, 0, 1}, {0, 0.5, 0, 2}};
+    const std::vector<std::uint32_t> bad_w = {0, 1, 2}, bad_index = {0, 1, 9}, bad_count = {0, 1};
+    raster::VisibilityPass pass;
+    auto r = pass.run(16, 16, DepthFormat::D24, std::vector<raster::VisibilityItem>{{{v, bad_w}, 0}}, 1);
+    REQUIRE(!r.ok());
+    CHECK(r.error().message.find("item 0: vertex 2 has w = 2") != std::string::npos);
+    r = pass.run(16, 16, DepthFormat::D24, std::vector<raster::VisibilityItem>{{{v, bad_count}, 0}, {{v, bad_index}, 1}},
+                 1);
+    REQUIRE(!r.ok());
+    CHECK(r.error().message.find("item 0: index count 2") != std::string::npos);
+    r = pass.run(16, 16, DepthFormat::D24, std::vector<raster::VisibilityItem>{{{v, bad_index}, 1}}, 1);
+    REQUIRE(!r.ok());
+    CHECK(r.error().message.find("index 9 at position 2") != std::string::npos);
+    r = pass.run(0, 16, DepthFormat::D24, {}, 1);
+    REQUIRE(!r.ok());
+    CHECK(r.error().message.find("target 0x16") != std::string::npos);
+    r = pass.run(16, 16, DepthFormat::D24, {}, 1);
+    REQUIRE(r.ok());
+    CHECK(r.value().empty());
+}
