@@ -331,3 +331,29 @@ TEST_CASE("every method refuses coordinates outside the exact range, as the grou
         CHECK(r.error().message == exact.error().message);
     }
 }
+
+TEST_CASE("a view 2^-195 thin along one axis does not overflow the offset solids") {
+    // Regression of a pipeline_fuzz finding: two objects whose bounds span 2^-195 along y gave a
+    // view scale near 2^195, and rcullide-offset failed with "its box overflows float in clip
+    // space" on a scene the ground truth accepts. The solids are now saturated in double first.
+    std::vector<cullide::Mesh> objects(2);
+    for (int o = 0; o < 2; ++o) objects[static_cast<std::size_t>(o)].name = "m" + std::to_string(o);
+    objects[0].positions = {{0x1.5cp+1, -0x1.ac8f1032405ffp-195, 0x1.c8p+0}, {0, 0, 0}};
+    objects[0].triangles = {{0, 0, 0}, {0, 1, 1}};
+    objects[1].positions = {{0, 0, 0}, {1, 0, 0.5}};
+    objects[1].triangles = {{0, 0, 0}, {0, 1, 0}};
+    const auto exact = cullide::exact_pairs(objects);
+    REQUIRE(exact.ok());
+    for (Method m : {Method::RCullide, Method::RCullideOffset}) {
+        for (int res : {16, 216, 1024}) {
+            CAPTURE(cullide::to_string(m));
+            CAPTURE(res);
+            cullide::RunOptions o;
+            o.method = m;
+            o.resolution = res;
+            auto r = cullide::process_frame(objects, o);
+            REQUIRE_MESSAGE(r.ok(), (r.ok() ? std::string() : r.error().message));
+            CHECK(r.value().pairs == exact.value());
+        }
+    }
+}
