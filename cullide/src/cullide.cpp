@@ -10,10 +10,13 @@
 
 #include "cullide/predicates.h"
 #include "cullide/tri_tri.h"
+#include "cullide_detail.h"
+#include "emulator_device.h"
 #include "parallel.h"
 #include "raster/command_batch.h"
 #include "raster/offset_geometry.h"
 #include "raster/transform.h"
+#include "raster/visibility.h"
 
 namespace cullide {
 namespace {
@@ -59,6 +62,11 @@ struct ObjectGeometry {
     raster::OffsetMesh offset;
 };
 
+}  // namespace
+
+// Shared with quick_cullide.cpp (cullide_detail.h).
+namespace detail {
+
 Aabb unite(const Aabb& a, const Aabb& b) {
     if (a.empty()) return b;
     if (b.empty()) return a;
@@ -100,6 +108,13 @@ Result<raster::OrthoView> make_view(int axis, const Aabb& bounds, double extra_d
     if (!v) return Error{"view: " + v.error().message};
     return v.value();
 }
+
+}  // namespace detail
+
+namespace {
+
+using detail::make_view;
+using detail::unite;
 
 // This view's geometry of one object (see ObjectGeometry).
 Status prepare_geometry(ObjectGeometry& og, CullStage stage, const raster::OrthoView& view, VisibilityMode mode) {
@@ -190,6 +205,52 @@ void record_pass(raster::CommandBatch& batch, std::vector<ObjectGeometry>& g, co
     }
 }
 
+// The queries and triangles of the two passes record_pass would record for `order` (the fused pass
+// reports what it replaces).
+void count_passes(const std::vector<ObjectGeometry>& g, const std::vector<std::size_t>& order, ViewStats& vs) {
+    for (int pass = 0; pass < 2; ++pass) {
+        const std::size_t last = pass == 0 ? order.back() : order.front();
+        for (std::size_t i : order) {
+            for (const Item& it : g[i].items) {
+                if (!it.live) continue;
+                ++vs.queries;
+                vs.triangles_rasterized += it.index_count / 3;
+                if (i != last) vs.triangles_rasterized += it.index_count / 3;
+            }
+        }
+    }
+}
+
+// Both passes of one view at once on the emulator (raster/visibility.h); prunes the fully visible
+// items. Same answers as recording them (tests/cullide/fused_visibility_test.cpp compares the two).
+Result<std::uint64_t> fused_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_t>& order,
+                                 const CullideOptions& o, int threads, raster::VisibilityPass& pass, ViewStats& vs) {
+    std::vector<raster::VisibilityItem> items;
+    std::vector<Item*> refs;
+    for (std::size_t k = 0; k < order.size(); ++k) {
+        ObjectGeometry& og = g[order[k]];
+        for (Item& it : og.items) {
+            if (!it.live) continue;
+            items.push_back({raster::MeshViewD{og.clip_d, std::span<const std::uint32_t>(og.indices)
+                                                              .subspan(it.first_index, it.index_count)},
+                             static_cast<std::uint32_t>(k)});
+            refs.push_back(&it);
+        }
+    }
+    count_passes(g, order, vs);
+    raster::Result<std::vector<std::uint8_t>> r =
+        pass.run(o.resolution, o.resolution, o.depth_format, items, threads);
+    if (!r) return Error{"emulator device: " + r.error().message};
+    std::uint64_t pruned = 0;
+    for (std::size_t i = 0; i < refs.size(); ++i) {
+        if (r.value()[i] == 0) {
+            refs[i]->live = false;
+            ++pruned;
+        }
+    }
+    return pruned;
+}
+
 // Fits the view and prepares the live objects' geometry for it. Offset mode: widens the depth range
 // until no offset solid reaches past the near or far plane (the offset radius depends on the pixel
 // size, which widening the depth range does not change, and on the depth quantum, which it barely
@@ -220,8 +281,10 @@ Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_
 // Views along x, y, z in turn until three views in a row prune nothing (then the PCS, and so every
 // further view, is unchanged) or 3 * max_rounds views ran.
 Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideOptions& o, QueryDevice& device,
-                 CullideStats& st) {
+                 CullideStats& st, raster::VisibilityPass& fused) {
     const int res = o.resolution;
+    const int emulator_threads = detail::emulator_threads(device);
+    const bool use_fused = o.fused_visibility && o.mode == VisibilityMode::ExactBounds && emulator_threads > 0;
     int quiet = 0;
     for (int view = 0; view < 3 * o.max_rounds && quiet < 3; ++view) {
         std::vector<std::size_t> order;
@@ -243,6 +306,16 @@ Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideO
         vs.stage = stage;
         vs.axis = axis;
         vs.items_before = count_live(g);
+        if (use_fused) {
+            Result<std::uint64_t> pruned = fused_view(g, order, o, emulator_threads, fused, vs);
+            if (!pruned) return pruned.error();
+            vs.items_after = vs.items_before - pruned.value();
+            st.queries += vs.queries;
+            st.triangles_rasterized += vs.triangles_rasterized;
+            st.views.push_back(vs);
+            quiet = pruned.value() == 0 ? quiet + 1 : 0;
+            continue;
+        }
         std::array<raster::QueryResults, 2> results;
         for (int pass = 0; pass < 2; ++pass) {
             if (pass == 1) std::reverse(order.begin(), order.end());  // pass 2 runs backward
@@ -411,6 +484,7 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
     if (Status s = check_inputs(objects, active, options); !s) return s.error();
     CullideStats st;
     st.objects_in = active.size();
+    raster::VisibilityPass fused;  // reused by every view of the frame
 
     // Stage 1: object boxes.
     auto t0 = Clock::now();
@@ -425,7 +499,7 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
         og.indices.assign(kBoxIndices.begin(), kBoxIndices.end());
         og.items.push_back({0, 36, b, true, {}});
     }
-    if (Status s = run_stage(boxes, CullStage::Boxes, options, device, st); !s) return s.error();
+    if (Status s = run_stage(boxes, CullStage::Boxes, options, device, st, fused); !s) return s.error();
     st.pcs_boxes = count_live(boxes);
     st.boxes_ms = ms_since(t0);
 
@@ -443,7 +517,7 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
         og.items.push_back({0, static_cast<std::uint32_t>(og.indices.size()), b.items[0].box, true, {}});
         whole.push_back(std::move(og));
     }
-    if (Status s = run_stage(whole, CullStage::Objects, options, device, st); !s) return s.error();
+    if (Status s = run_stage(whole, CullStage::Objects, options, device, st, fused); !s) return s.error();
     st.pcs_objects = count_live(whole);
     st.objects_ms = ms_since(t0);
 
@@ -468,7 +542,7 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
         st.subobjects += og.items.size();
         subs.push_back(std::move(og));
     }
-    if (Status s = run_stage(subs, CullStage::SubObjects, options, device, st); !s) return s.error();
+    if (Status s = run_stage(subs, CullStage::SubObjects, options, device, st, fused); !s) return s.error();
     st.pcs_subobjects = count_live(subs);
     st.subobjects_ms = ms_since(t0);
 

@@ -2,6 +2,7 @@
 #include <optional>
 
 #include "cullide/query_device.h"
+#include "emulator_device.h"
 #include "parallel.h"
 #include "raster/depth_target.h"
 
@@ -33,6 +34,7 @@ class EmulatorDevice final : public QueryDevice {
     }
 
     std::string name() const override { return "emulator"; }
+    int threads() const { return threads_; }
 
    private:
     int threads_;
@@ -40,6 +42,11 @@ class EmulatorDevice final : public QueryDevice {
 };
 
 }  // namespace
+
+int detail::emulator_threads(const QueryDevice& device) {
+    const auto* e = dynamic_cast<const EmulatorDevice*>(&device);
+    return e != nullptr ? e->threads() : -1;
+}
 
 std::unique_ptr<QueryDevice> make_emulator_device(int threads) { return std::make_unique<EmulatorDevice>(threads); }
 

@@ -81,6 +81,11 @@ struct CullideOptions {
     int subobject_triangles = 4;  // triangles per sub-object, >= 1
     int max_rounds = 4;           // rounds of three views per stage, >= 1
     int threads = 0;              // exact stage workers; 0 = all hardware threads
+    // ExactBounds on the emulator device: answer each view's two passes with one fused
+    // raster::VisibilityPass (raster/visibility.h: the same answers, bit for bit, at a quarter of the
+    // rasterization). The statistics still count the queries and triangles of the two recorded
+    // passes it replaces. false records and executes the passes (tests compare the two).
+    bool fused_visibility = true;
 };
 
 struct CullideStats {
