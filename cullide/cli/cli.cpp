@@ -32,19 +32,22 @@ constexpr const char* kUsage =
     "one object, or one object per OBJ group, in argument order.\n"
     "\n"
     "run options:\n"
-    "  --method M        exact (default; the ground truth), cullide (GL-exact visibility culling, may\n"
-    "                    miss collisions like the GPU original), rcullide (R-CULLIDE, exact-bounds\n"
-    "                    conservative raster: never misses), rcullide-offset (R-CULLIDE with the\n"
-    "                    paper's offset solids: never misses)\n"
+    "  --method M        rcullide (default; R-CULLIDE, exact-bounds conservative raster: never\n"
+    "                    misses), exact (the ground truth), cullide (GL-exact visibility culling, may\n"
+    "                    miss collisions like the GPU original), rcullide-offset (R-CULLIDE with the\n"
+    "                    paper's offset solids: never misses), qcullide (Quick-CULLIDE, exact-bounds:\n"
+    "                    never misses; the default with --self), qcullide-gl (Quick-CULLIDE, GL-exact)\n"
     "  --frames N        frames to run (default 10 for built-in scenes, 1 for files; 1..1000000)\n"
     "  --threads T       worker threads, 0 = all cores (default 0); results do not depend on it\n"
-    "  --resolution R    view resolution of visibility methods, 16..16384 (default 1024)\n"
+    "  --resolution R    view resolution of visibility methods, 16..16384 (default 32 for rcullide,\n"
+    "                    1024 for the others)\n"
     "  --depth-format F  depth buffer of visibility methods: d16, d24 (default), d32f\n"
     "  --subobject N     triangles per sub-object of visibility methods, 1..65536 (default 4)\n"
     "  --rounds N        rounds of x, y, z views per visibility stage, 1..1000 (default 4)\n"
     "  --broadphase B    first stage on object boxes: none (default), spatialhash, sap, brute;\n"
     "                    objects overlapping no other box are dropped at once\n"
-    "  --self            also report pairs inside one object (adjacent triangles excluded)\n"
+    "  --self            also report pairs inside one object (adjacent triangles excluded); methods\n"
+    "                    exact, qcullide, qcullide-gl\n"
     "  --pairs FILE      write every colliding triangle pair as CSV:\n"
     "                    frame,object_a,triangle_a,object_b,triangle_b\n"
     "  --json            print the per-frame results as one JSON document instead of text\n"
@@ -91,6 +94,8 @@ std::string json_escape(const std::string& s) {
 struct RunArgs {
     std::vector<std::string> scene;
     RunOptions options;
+    bool method_given = false;  // --self without --method runs qcullide
+    bool resolution_given = false;  // else the method's default_resolution
     std::optional<int> frames;
     std::string pairs_file;
     bool json = false;
@@ -110,6 +115,7 @@ RunArgs parse_run_args(const std::vector<std::string>& args) {
             Result<Method> m = parse_method(v);
             if (!m) throw UsageError{m.error().message};
             r.options.method = m.value();
+            r.method_given = true;
         } else if (a == "--frames") {
             const std::string& v = need_value(i);
             auto n = parse_integer<int>(v);
@@ -127,6 +133,7 @@ RunArgs parse_run_args(const std::vector<std::string>& args) {
                 throw UsageError{"--resolution must be an integer in 16..16384 (got '" + v + "')"};
             }
             r.options.resolution = *n;
+            r.resolution_given = true;
         } else if (a == "--depth-format") {
             Result<raster::DepthFormat> f = parse_depth_format(need_value(i));
             if (!f) throw UsageError{"--depth-format: " + f.error().message};
@@ -169,6 +176,8 @@ RunArgs parse_run_args(const std::vector<std::string>& args) {
             r.scene.push_back(a);
         }
     }
+    if (r.options.self && !r.method_given) r.options.method = Method::QCullide;
+    if (!r.resolution_given) r.options.resolution = default_resolution(r.options.method);
     return r;
 }
 

@@ -21,7 +21,9 @@ Result<E> parse_name(std::string_view what, std::string_view name, const std::pa
 constexpr std::pair<const char*, Method> kMethods[] = {{"exact", Method::Exact},
                                                        {"cullide", Method::Cullide},
                                                        {"rcullide", Method::RCullide},
-                                                       {"rcullide-offset", Method::RCullideOffset}};
+                                                       {"rcullide-offset", Method::RCullideOffset},
+                                                       {"qcullide", Method::QCullide},
+                                                       {"qcullide-gl", Method::QCullideGL}};
 constexpr std::pair<const char*, BroadPhase> kBroadPhases[] = {{"none", BroadPhase::None},
                                                                {"spatialhash", BroadPhase::SpatialHash},
                                                                {"sap", BroadPhase::SweepAndPrune},
@@ -82,11 +84,17 @@ Result<raster::DepthFormat> parse_depth_format(std::string_view name) {
     return parse_name("depth format", name, kDepthFormats);
 }
 
+int default_resolution(Method m) {
+    return m == Method::RCullide ? kDefaultResolutionRCullide : kDefaultResolutionOthers;
+}
+
 Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOptions& options) {
     if (options.threads < 0) return Error{"threads must be >= 0 (got " + std::to_string(options.threads) + ")"};
-    if (options.self && options.method != Method::Exact)
+    if (options.self && options.method != Method::Exact && options.method != Method::QCullide &&
+        options.method != Method::QCullideGL)
         return Error{std::string("self-collision is not supported by method '") + to_string(options.method) +
-                     "' (CULLIDE never tests an object against itself); use method 'exact'"};
+                     "' (CULLIDE never tests an object against itself); use method 'qcullide', 'qcullide-gl' "
+                     "or 'exact'"};
     const auto start = std::chrono::steady_clock::now();
     if (Status s = validate_scene(objects); !s) return s.error();
     // Every method ends in the exact test: the same range as the ground truth, for all of them
@@ -169,6 +177,44 @@ Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOption
             st.objects_ms = cs.objects_ms;
             st.subobjects_ms = cs.subobjects_ms;
             st.exact_ms = cs.exact_ms;
+            break;
+        }
+        case Method::QCullide:
+        case Method::QCullideGL: {
+            QuickOptions qo;
+            qo.mode = options.method == Method::QCullide ? VisibilityMode::ExactBounds : VisibilityMode::GLExact;
+            qo.self = options.self;
+            qo.resolution = options.resolution;
+            qo.depth_format = options.depth_format;
+            qo.subobject_triangles = options.subobject_triangles;
+            qo.max_rounds = options.max_rounds;
+            qo.threads = options.threads;
+            std::unique_ptr<QueryDevice> own;
+            QueryDevice* device = options.device;
+            if (device == nullptr) {
+                own = make_emulator_device(options.threads);
+                device = own.get();
+            }
+            QuickStats qs;
+            Result<std::vector<TrianglePair>> pairs = quick_cullide_pairs(objects, active.value(), qo, *device, &qs);
+            if (!pairs) return pairs.error();
+            result.pairs = std::move(pairs).value();
+            st.candidate_triangles = qs.candidate_triangles;
+            st.exact_tests = qs.exact_tests;
+            st.adjacent_skipped = qs.adjacent_skipped;
+            // With self-collision no object leaves at object level (it may collide with itself).
+            st.pcs_boxes = options.self ? qs.objects_in : qs.pcs_boxes;
+            st.pcs_objects = options.self ? qs.objects_in : qs.pcs_objects;
+            st.subobjects = qs.subobjects;
+            st.pcs_subobjects = qs.pcs_subobjects;
+            st.subobject_pairs = qs.item_pairs_kept;
+            st.queries = qs.queries;
+            st.triangles_rasterized = qs.triangles_rasterized;
+            st.views = std::move(qs.views);
+            st.boxes_ms = qs.boxes_ms;
+            st.objects_ms = qs.objects_ms;
+            st.subobjects_ms = qs.subobjects_ms;
+            st.exact_ms = qs.exact_ms;
             break;
         }
     }

@@ -114,7 +114,7 @@ TEST_CASE("the pair file holds exactly the library's pairs, frame by frame, sort
 }
 
 TEST_CASE("--json prints one document with a record per frame") {
-    Outcome o = run({"run", "--scale", "0.1", "--frames", "2", "--json"});
+    Outcome o = run({"run", "--method", "exact", "--scale", "0.1", "--frames", "2", "--json"});
     REQUIRE(o.status == 0);
     CHECK(o.out.rfind("{\"scene\": \"cylinders\", \"method\": \"exact\"", 0) == 0);
     CHECK(o.out.find("{\"frame\": 0,") != std::string::npos);
@@ -159,7 +159,7 @@ TEST_CASE("bad visibility options are usage errors naming the option and the val
     o = run({"run", "--rounds", "x"});
     CHECK(o.status == 2);
     o = run({"run", "--method", "magic"});
-    CHECK(has(o.err, "(valid: exact, cullide, rcullide, rcullide-offset)"));
+    CHECK(has(o.err, "(valid: exact, cullide, rcullide, rcullide-offset, qcullide, qcullide-gl)"));
     o = run({"run", "--method", "cullide", "--self", "--scale", "0.05", "--frames", "1"});
     CHECK(o.status == 1);
     CHECK(has(o.err, "self-collision is not supported by method 'cullide'"));

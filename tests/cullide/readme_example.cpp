@@ -7,7 +7,7 @@ int main() {
     auto scene = cullide::make_scene("cylinders", {});  // built-in scene, default seed
     if (!scene) return std::fprintf(stderr, "%s\n", scene.error().message.c_str()), 1;
     cullide::Frame objects = scene.value()->frame(0);  // a std::vector<cullide::Mesh>
-    cullide::RunOptions options;                       // method exact, all cores
+    cullide::RunOptions options;                       // method rcullide, all cores
     auto result = cullide::process_frame(objects, options);
     if (!result) return std::fprintf(stderr, "%s\n", result.error().message.c_str()), 1;
     for (const cullide::TrianglePair& p : result.value().pairs)

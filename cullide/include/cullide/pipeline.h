@@ -16,6 +16,7 @@
 #include "cullide/cullide.h"
 #include "cullide/ground_truth.h"
 #include "cullide/mesh.h"
+#include "cullide/quick_cullide.h"
 #include "cullide/result.h"
 
 namespace cullide {
@@ -25,6 +26,8 @@ enum class Method {
     Cullide,         // CULLIDE, GL-exact visibility (may miss collisions, like the GPU original)
     RCullide,        // R-CULLIDE in the emulator's exact-bounds raster mode (never misses; emulator only)
     RCullideOffset,  // R-CULLIDE with the paper's offset solids, pixel-centre GL (never misses; any device)
+    QCullide,        // Quick-CULLIDE, exact-bounds mode (never misses; emulator only; self-collision)
+    QCullideGL,      // Quick-CULLIDE, GL-exact mode (may miss; any device; self-collision)
 };
 
 // The optional first stage, on the objects' axis-aligned boxes (spatialhash/broad_phase.h).
@@ -43,12 +46,22 @@ enum class BroadPhase { None, SpatialHash, SweepAndPrune, BruteForce };
 // Names accepted by parse_method, in order.
 [[nodiscard]] std::vector<std::string> method_names();
 
+// Default view resolution per method (pixels per side), measured (docs/cullide.md, "Defaults"):
+// rcullide's cost falls with the resolution while the exact stage removes the extra false
+// positives, so it runs best low; the pixel-centre methods miss less at high resolution.
+inline constexpr int kDefaultResolutionRCullide = 32;
+inline constexpr int kDefaultResolutionOthers = 1024;
+[[nodiscard]] int default_resolution(Method m);
+
 struct RunOptions {
-    Method method = Method::Exact;
+    Method method = Method::RCullide;  // R-CULLIDE (exact-bounds): never misses, ends in the exact test
     int threads = 0;          // 0 = all hardware threads; results do not depend on it
-    int resolution = 1024;    // view resolution of the visibility methods (pixels per side)
+    // View resolution of the visibility methods (pixels per side); the default is rcullide's
+    // (default_resolution: set it when choosing another method; the CLI does).
+    int resolution = kDefaultResolutionRCullide;
     bool self = false;        // also report pairs inside one object (adjacent triangles excluded);
-                              // exact only (CULLIDE never tests an object against itself)
+                              // exact, qcullide and qcullide-gl only (CULLIDE never tests an object
+                              // against itself)
     raster::DepthFormat depth_format = raster::DepthFormat::D24;  // visibility methods
     int subobject_triangles = 4;  // triangles per sub-object (visibility methods), >= 1
     int max_rounds = 4;           // rounds of x, y, z views per visibility stage, >= 1

@@ -1,0 +1,612 @@
+// quick_cullide.cpp: Quick-CULLIDE (see cullide/quick_cullide.h, docs/quick-cullide.md).
+#include "cullide/quick_cullide.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <string>
+
+#include "cullide/tri_tri.h"
+#include "cullide_detail.h"
+#include "parallel.h"
+#include "raster/command_batch.h"
+#include "raster/depth_target.h"
+#include "raster/transform.h"
+
+namespace cullide {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+constexpr std::uint8_t kFFV = 1;  // apart from every earlier item that is not near
+constexpr std::uint8_t kSFV = 2;  // apart from every later item that is not near
+constexpr std::uint8_t kBFV = kFFV | kSFV;
+
+// Box corners: x from bit 0, y from bit 1, z from bit 2 (as cullide.cpp; no face culling).
+constexpr std::array<std::uint32_t, 36> kBoxIndices = {0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5, 0, 1, 5, 0, 5, 4,
+                                                       2, 6, 7, 2, 7, 3, 0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6};
+
+// One object's geometry for a stage: triangles in the stage's order (`order[p]` is the mesh
+// triangle at position p; for a box, the 12 box triangles and an empty order).
+struct Geom {
+    std::uint32_t object = 0;  // index into `objects`
+    std::vector<raster::Double3> positions;
+    std::vector<std::uint32_t> indices;  // three per position
+    std::vector<std::uint32_t> order;
+    std::vector<Aabb> tri_box;           // per position (exact stage)
+    std::vector<std::uint32_t> weld;     // welded vertex ids (self only)
+    std::vector<raster::Float4> clip;
+    std::vector<raster::Double4> clip_d;
+};
+
+// One item: positions [first, first + count) of its geometry. near_lo..near_hi (global item
+// positions, inclusive) are the items it is never tested against by the visibility passes.
+struct Item {
+    std::uint32_t geom = 0;
+    std::uint32_t first = 0, count = 0;
+    Aabb box;
+    std::uint8_t tag = 0;
+    std::uint32_t near_lo = 0, near_hi = 0;
+    std::uint32_t query = 0;
+};
+
+Status check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active, const QuickOptions& o) {
+    if (o.mode == VisibilityMode::Offset)
+        return Error{"Quick-CULLIDE runs in GL-exact or exact-bounds mode, not with offset solids"};
+    if (o.resolution < 1 || o.resolution > raster::kMaxTargetSize)
+        return Error{"resolution must be in 1.." + std::to_string(raster::kMaxTargetSize) + " (got " +
+                     std::to_string(o.resolution) + ")"};
+    if (o.subobject_triangles < 1)
+        return Error{"sub-object size must be >= 1 triangle (got " + std::to_string(o.subobject_triangles) + ")"};
+    if (o.max_rounds < 1 || o.max_rounds > 1000)
+        return Error{"max_rounds must be in 1..1000 (got " + std::to_string(o.max_rounds) + ")"};
+    if (o.threads < 0) return Error{"threads must be >= 0 (got " + std::to_string(o.threads) + ")"};
+    if (Status s = validate_scene(objects); !s) return s;
+    if (Status s = validate_exact_range(objects); !s) return s;
+    if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
+    for (std::size_t k = 0; k < active.size(); ++k) {
+        if (active[k] >= objects.size())
+            return Error{"active object " + std::to_string(k) + " = " + std::to_string(active[k]) +
+                         " is beyond the object list (size " + std::to_string(objects.size()) + ")"};
+        if (k > 0 && active[k] <= active[k - 1])
+            return Error{"active objects must be strictly increasing (entry " + std::to_string(k) + ")"};
+        if (objects[active[k]].triangles.size() > UINT32_MAX / 3)
+            return Error{"object " + std::to_string(active[k]) + ": too many triangles (limit 2^32 / 3)"};
+    }
+    return Status{};
+}
+
+std::uint64_t count_live(const std::vector<Item>& items) {
+    return static_cast<std::uint64_t>(
+        std::count_if(items.begin(), items.end(), [](const Item& it) { return it.tag != kBFV; }));
+}
+
+std::uint64_t record_draw(raster::CommandBatch& batch, const Geom& g, const Item& it, VisibilityMode mode, bool query) {
+    raster::DrawState state;
+    state.depth_func = query ? raster::DepthFunc::GEqual : raster::DepthFunc::LEqual;
+    state.depth_write = !query;
+    const auto idx = std::span<const std::uint32_t>(g.indices).subspan(std::size_t{it.first} * 3, std::size_t{it.count} * 3);
+    if (mode == VisibilityMode::ExactBounds) {
+        state.mode = raster::RasterMode::ExactBounds;
+        batch.draw(raster::MeshViewD{g.clip_d, idx}, state);
+    } else {
+        batch.draw(raster::MeshView{g.clip, idx}, state);
+    }
+    return it.count;
+}
+
+Status run_device(QueryDevice& device, const raster::CommandBatch& batch, const QuickOptions& o,
+                  raster::QueryResults& out) {
+    if (Status s = device.clear(o.resolution, o.resolution, o.depth_format); !s) return s;
+    Result<raster::QueryResults> r = device.execute(batch);
+    if (!r) return r.error();
+    if (r.value().size() != batch.query_kinds().size())
+        return Error{"device returned " + std::to_string(r.value().size()) + " query results for " +
+                     std::to_string(batch.query_kinds().size()) + " queries"};
+    out = std::move(r).value();
+    return Status{};
+}
+
+// Views until three views in a row are quiet (gain at most 1/64 of the live items' count in tags)
+// or 3 * max_rounds ran.
+// Pass 1 draws item j right after the query of item near_hi[j] (pass 2: near_lo[j]); both are
+// non-decreasing in j, so one cursor per pass schedules every deferred draw.
+Status run_stage(std::vector<Geom>& geoms, std::vector<Item>& items, CullStage stage, const QuickOptions& o,
+                 QueryDevice& device, QuickStats& st) {
+    if (o.skip_visibility) return Status{};
+    CullideOptions co;
+    co.resolution = o.resolution;
+    co.depth_format = o.depth_format;
+    const std::size_t n = items.size();
+    int quiet = 0;
+    int first_axis = -1;  // the thinnest axis of the stage's first live bounds (see below)
+    for (int view = 0; view < 3 * o.max_rounds && quiet < 3; ++view) {
+        Aabb bounds;
+        std::vector<char> geom_live(geoms.size(), 0);
+        std::uint64_t live = 0;
+        for (const Item& it : items) {
+            if (it.tag == kBFV) continue;
+            ++live;
+            bounds = detail::unite(bounds, it.box);
+            geom_live[it.geom] = 1;
+        }
+        if (live == 0) return Status{};
+        // Views start along the axis of least extent (ours: a sheet seen face-on is proven apart in
+        // one view, where CULLIDE's fixed x, y, z cycle may spend two edge-on views first), then cycle.
+        if (first_axis < 0) {
+            first_axis = 0;
+            for (int k = 1; k < 3; ++k)
+                if (bounds.hi[k] - bounds.lo[k] < bounds.hi[first_axis] - bounds.lo[first_axis]) first_axis = k;
+        }
+        const int axis = (first_axis + view) % 3;
+        Result<raster::OrthoView> v = detail::make_view(axis, bounds, 0.0, co);
+        if (!v) return v.error();
+        for (std::size_t gi = 0; gi < geoms.size(); ++gi) {
+            if (!geom_live[gi]) continue;
+            Geom& g = geoms[gi];
+            raster::Result<std::vector<raster::Double4>> c = raster::ortho_view_to_clip(v.value(), g.positions);
+            if (!c) return Error{"view transform: " + c.error().message};
+            if (o.mode == VisibilityMode::ExactBounds) {
+                g.clip_d = std::move(c).value();
+            } else {
+                g.clip.resize(c.value().size());
+                for (std::size_t i = 0; i < g.clip.size(); ++i) {
+                    const raster::Double4& d = c.value()[i];
+                    g.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), static_cast<float>(d.z), 1.0f};
+                }
+            }
+        }
+        ViewStats vs;
+        vs.stage = stage;
+        vs.axis = axis;
+        vs.items_before = live;
+        std::uint64_t changed = 0;  // tags gained in this view
+        raster::QueryResults res;
+        // Pass 1, forward.
+        {
+            raster::CommandBatch batch(o.resolution, o.resolution);
+            std::size_t r = 0;
+            for (std::size_t k = 0; k < n; ++k) {
+                Item& it = items[k];
+                if (!(it.tag & kFFV)) {
+                    it.query = batch.begin_query(raster::QueryKind::AnySamplesPassed);
+                    vs.triangles_rasterized += record_draw(batch, geoms[it.geom], it, o.mode, true);
+                    batch.end_query();
+                    ++vs.queries;
+                }
+                if (k + 1 == n) break;  // nothing is queried after the last item
+                for (; r < n && items[r].near_hi <= k; ++r)
+                    if (!(items[r].tag & kSFV))
+                        vs.triangles_rasterized += record_draw(batch, geoms[items[r].geom], items[r], o.mode, false);
+            }
+            if (Status s = run_device(device, batch, o, res); !s) return s;
+            for (Item& it : items) {
+                if (!(it.tag & kFFV) && res[it.query] == 0) {
+                    it.tag |= kFFV;
+                    ++changed;
+                }
+            }
+        }
+        // Pass 2, backward.
+        {
+            raster::CommandBatch batch(o.resolution, o.resolution);
+            std::size_t r = n;  // items [r, n) are scheduled
+            for (std::size_t k = n; k-- > 0;) {
+                Item& it = items[k];
+                if (!(it.tag & kSFV)) {
+                    it.query = batch.begin_query(raster::QueryKind::AnySamplesPassed);
+                    vs.triangles_rasterized += record_draw(batch, geoms[it.geom], it, o.mode, true);
+                    batch.end_query();
+                    ++vs.queries;
+                }
+                if (k == 0) break;
+                for (; r > 0 && items[r - 1].near_lo >= k; --r)
+                    if (!(items[r - 1].tag & kFFV))
+                        vs.triangles_rasterized +=
+                            record_draw(batch, geoms[items[r - 1].geom], items[r - 1], o.mode, false);
+            }
+            if (Status s = run_device(device, batch, o, res); !s) return s;
+            for (Item& it : items) {
+                if (!(it.tag & kSFV) && res[it.query] == 0) {
+                    it.tag |= kSFV;
+                    ++changed;
+                }
+            }
+        }
+        vs.items_after = count_live(items);
+        st.queries += vs.queries;
+        st.triangles_rasterized += vs.triangles_rasterized;
+        st.views.push_back(vs);
+        // A view is quiet when it proved (nearly) nothing: fewer new tags than 1/64 of the live
+        // items (ours: touching pieces that can never be proven apart otherwise keep every view
+        // busy for a handful of tags; what is left goes to the exact stage, which decides).
+        quiet = changed > live / 64 ? 0 : quiet + 1;
+    }
+    return Status{};
+}
+
+// Welded-vertex -> triangles (CSR), triangles listed in increasing id.
+struct VertexTriangles {
+    std::vector<std::uint32_t> start, tris;
+};
+
+VertexTriangles vertex_triangles(const Mesh& m, const std::vector<std::uint32_t>& weld) {
+    std::uint32_t nv = 0;
+    for (std::uint32_t w : weld) nv = std::max(nv, w + 1);
+    VertexTriangles vt;
+    vt.start.assign(std::size_t{nv} + 1, 0);
+    for (const Tri& t : m.triangles)
+        for (std::uint32_t v : t) ++vt.start[weld[v] + 1];
+    for (std::size_t i = 0; i < nv; ++i) vt.start[i + 1] += vt.start[i];
+    vt.tris.resize(vt.start[nv]);
+    std::vector<std::uint32_t> fill(vt.start.begin(), vt.start.end() - 1);
+    for (std::size_t t = 0; t < m.triangles.size(); ++t)
+        for (std::uint32_t v : m.triangles[t]) vt.tris[fill[weld[v]]++] = static_cast<std::uint32_t>(t);
+    return vt;
+}
+
+// Breadth-first order over vertex-sharing triangles (Cuthill-McKee without the degree sort),
+// components started from `seeds` in turn; `last` receives each component's last triangle.
+std::vector<std::uint32_t> bfs_order(const Mesh& m, const std::vector<std::uint32_t>& weld, const VertexTriangles& vt,
+                                     const std::vector<std::uint32_t>& seeds, std::vector<std::uint32_t>* last) {
+    const std::size_t nt = m.triangles.size();
+    std::vector<char> seen(nt, 0);
+    std::vector<std::uint32_t> order;
+    order.reserve(nt);
+    auto grow = [&](std::uint32_t s) {
+        if (seen[s]) return;
+        seen[s] = 1;
+        std::size_t head = order.size();
+        order.push_back(s);
+        for (; head < order.size(); ++head) {
+            for (std::uint32_t v : m.triangles[order[head]]) {
+                const std::uint32_t w = weld[v];
+                for (std::uint32_t k = vt.start[w]; k < vt.start[w + 1]; ++k) {
+                    const std::uint32_t u = vt.tris[k];
+                    if (!seen[u]) {
+                        seen[u] = 1;
+                        order.push_back(u);
+                    }
+                }
+            }
+        }
+        if (last != nullptr) last->push_back(order.back());
+    };
+    for (std::uint32_t s : seeds) grow(s);
+    for (std::size_t t = 0; t < nt; ++t) grow(static_cast<std::uint32_t>(t));
+    return order;
+}
+
+// The window of a triangle order grouped `group` per item: the largest item distance between
+// two triangles sharing a welded vertex.
+std::uint32_t window_of(const std::vector<std::uint32_t>& order, std::size_t group, const VertexTriangles& vt) {
+    std::vector<std::uint32_t> item_of(order.size());
+    for (std::size_t p = 0; p < order.size(); ++p) item_of[order[p]] = static_cast<std::uint32_t>(p / group);
+    std::uint32_t w = 0;
+    for (std::size_t v = 0; v + 1 < vt.start.size(); ++v) {
+        std::uint32_t lo = UINT32_MAX, hi = 0;
+        for (std::uint32_t k = vt.start[v]; k < vt.start[v + 1]; ++k) {
+            lo = std::min(lo, item_of[vt.tris[k]]);
+            hi = std::max(hi, item_of[vt.tris[k]]);
+        }
+        if (lo <= hi) w = std::max(w, hi - lo);
+    }
+    return w;
+}
+
+// The mesh geometry of `object` with its triangles in `order`.
+Geom make_mesh_geom(const Mesh& m, std::uint32_t object, std::vector<std::uint32_t> order) {
+    Geom g;
+    g.object = object;
+    g.positions.resize(m.positions.size());
+    for (std::size_t i = 0; i < m.positions.size(); ++i) g.positions[i] = {m.positions[i].x, m.positions[i].y, m.positions[i].z};
+    g.order = std::move(order);
+    g.indices.reserve(g.order.size() * 3);
+    g.tri_box.reserve(g.order.size());
+    for (std::uint32_t t : g.order) {
+        g.indices.insert(g.indices.end(), m.triangles[t].begin(), m.triangles[t].end());
+        g.tri_box.push_back(triangle_bounds(m, t));
+    }
+    return g;
+}
+
+// Splits every geometry with a live parent into items of `group` positions, inheriting the
+// parent's tag; parents are consecutive runs of `parents` per geometry. Non-self near range: the
+// object's items.
+std::vector<Item> split_items(const std::vector<Geom>& geoms, const std::vector<Item>& parents, std::size_t group) {
+    std::vector<Item> items;
+    for (const Item& p : parents) {
+        if (p.tag == kBFV) continue;
+        for (std::uint32_t f = p.first; f < p.first + p.count; f += static_cast<std::uint32_t>(group)) {
+            Item it;
+            it.geom = p.geom;
+            it.first = f;
+            it.count = std::min<std::uint32_t>(static_cast<std::uint32_t>(group), p.first + p.count - f);
+            for (std::uint32_t q = f; q < f + it.count; ++q) it.box = detail::unite(it.box, geoms[p.geom].tri_box[q]);
+            it.tag = p.tag;
+            items.push_back(it);
+        }
+    }
+    return items;
+}
+
+// near range = all items of the same geometry (no self-collision).
+void set_object_near(std::vector<Item>& items) {
+    std::size_t s = 0;
+    while (s < items.size()) {
+        std::size_t e = s;
+        while (e < items.size() && items[e].geom == items[s].geom) ++e;
+        for (std::size_t k = s; k < e; ++k) {
+            items[k].near_lo = static_cast<std::uint32_t>(s);
+            items[k].near_hi = static_cast<std::uint32_t>(e - 1);
+        }
+        s = e;
+    }
+}
+
+bool near(const Item& a, std::size_t b) { return b >= a.near_lo && b <= a.near_hi; }
+
+bool share_vertex(const Geom& g, const Mesh& m, std::uint32_t ta, std::uint32_t tb) {
+    for (std::uint32_t va : m.triangles[ta])
+        for (std::uint32_t vb : m.triangles[tb])
+            if (g.weld[va] == g.weld[vb]) return true;
+    return false;
+}
+
+using ItemPair = std::pair<std::uint32_t, std::uint32_t>;
+
+// Item pairs (a < b) whose boxes overlap, by sweep and prune on the axis of greatest extent; BFV
+// items only when `with_bfv`. Sorted.
+std::vector<ItemPair> box_pairs(const std::vector<Item>& items, bool with_bfv) {
+    std::vector<std::uint32_t> refs;
+    Aabb all;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        if (items[i].tag == kBFV && !with_bfv) continue;
+        refs.push_back(static_cast<std::uint32_t>(i));
+        all = detail::unite(all, items[i].box);
+    }
+    std::vector<ItemPair> out;
+    if (refs.empty()) return out;
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+        if (all.hi[k] - all.lo[k] > all.hi[axis] - all.lo[axis]) axis = k;
+    std::sort(refs.begin(), refs.end(), [&](std::uint32_t x, std::uint32_t y) {
+        if (items[x].box.lo[axis] != items[y].box.lo[axis]) return items[x].box.lo[axis] < items[y].box.lo[axis];
+        return x < y;
+    });
+    for (std::size_t i = 0; i < refs.size(); ++i) {
+        const Item& ri = items[refs[i]];
+        for (std::size_t j = i + 1; j < refs.size() && items[refs[j]].box.lo[axis] <= ri.box.hi[axis]; ++j) {
+            if (!overlaps(ri.box, items[refs[j]].box)) continue;
+            out.emplace_back(std::min(refs[i], refs[j]), std::max(refs[i], refs[j]));
+        }
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+// Self-collision box classification (ours, before the visibility passes): an item whose box meets
+// no earlier non-near item's box is FFV, none later: SFV. Geometric facts, like the passes' tags.
+void box_tags(std::vector<Item>& items, const std::vector<ItemPair>& overlapping) {
+    std::vector<std::uint8_t> open(items.size(), 0);  // the tag bits that are NOT proven
+    for (const auto& [a, b] : overlapping) {
+        if (near(items[a], b)) continue;
+        open[a] |= kSFV;
+        open[b] |= kFFV;
+    }
+    for (std::size_t i = 0; i < items.size(); ++i) items[i].tag |= static_cast<std::uint8_t>(kBFV & ~open[i]);
+}
+
+// The overlapping item pairs filtered by the tags, then triangle pairs by box, adjacency, and the
+// exact test.
+std::vector<TrianglePair> exact_stage(std::span<const Mesh> objects, const std::vector<Geom>& geoms,
+                                      const std::vector<Item>& items, const std::vector<ItemPair>& overlapping,
+                                      const QuickOptions& o, QuickStats& st) {
+    struct Pair {
+        std::uint32_t a, b;
+        bool near;
+    };
+    std::vector<Pair> pairs;
+    if (o.self)
+        for (std::size_t i = 0; i < items.size(); ++i)
+            if (items[i].count > 1) pairs.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i), true});
+    st.item_pairs = overlapping.size();
+    for (const auto& [a, b] : overlapping) {
+        const bool is_near = near(items[a], b);
+        if (is_near && !o.self) continue;  // pieces of one object (no self-collision)
+        if (!is_near && ((items[b].tag & kFFV) || (items[a].tag & kSFV))) continue;  // proven apart
+        pairs.push_back({a, b, is_near});
+    }
+    std::sort(pairs.begin(), pairs.end(), [](const Pair& x, const Pair& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+    st.item_pairs_kept = pairs.size();
+    std::vector<char> counted(items.size(), 0);
+    for (const Pair& p : pairs) {
+        st.near_item_pairs += p.near ? 1 : 0;
+        for (std::uint32_t i : {p.a, p.b}) {
+            if (!counted[i]) st.candidate_triangles += items[i].count;
+            counted[i] = 1;
+        }
+    }
+
+    constexpr std::size_t kChunk = 64;  // item pairs per task: fixed, so the output is thread-independent
+    const std::size_t chunks = (pairs.size() + kChunk - 1) / kChunk;
+    struct ChunkOut {
+        std::vector<TrianglePair> found;
+        std::uint64_t tests = 0, near_tests = 0, adjacent = 0;
+    };
+    std::vector<ChunkOut> out(chunks);
+    detail::parallel_chunks(o.threads, chunks, [&](std::size_t c) {
+        ChunkOut& co = out[c];
+        const std::size_t end = std::min(pairs.size(), (c + 1) * kChunk);
+        for (std::size_t p = c * kChunk; p < end; ++p) {
+            const Item& ia = items[pairs[p].a];
+            const Item& ib = items[pairs[p].b];
+            const Geom& ga = geoms[ia.geom];
+            const Geom& gb = geoms[ib.geom];
+            const Mesh& ma = objects[ga.object];
+            const Mesh& mb = objects[gb.object];
+            const bool same = ia.geom == ib.geom;
+            for (std::uint32_t pa = ia.first; pa < ia.first + ia.count; ++pa) {
+                const std::uint32_t first_b = pairs[p].a == pairs[p].b ? pa + 1 : ib.first;
+                for (std::uint32_t pb = first_b; pb < ib.first + ib.count; ++pb) {
+                    if (!overlaps(ga.tri_box[pa], gb.tri_box[pb])) continue;
+                    std::uint32_t ta = ga.order[pa], tb = gb.order[pb];
+                    if (same && share_vertex(ga, ma, ta, tb)) {
+                        ++co.adjacent;
+                        continue;
+                    }
+                    ++co.tests;
+                    co.near_tests += pairs[p].near ? 1 : 0;
+                    const Tri& a = ma.triangles[ta];
+                    const Tri& b = mb.triangles[tb];
+                    if (tri_tri_intersect(ma.positions[a[0]], ma.positions[a[1]], ma.positions[a[2]], mb.positions[b[0]],
+                                          mb.positions[b[1]], mb.positions[b[2]])) {
+                        if (same && tb < ta) std::swap(ta, tb);
+                        co.found.push_back({ga.object, ta, gb.object, tb});
+                    }
+                }
+            }
+        }
+    });
+    std::vector<TrianglePair> result;
+    for (const ChunkOut& co : out) {
+        st.exact_tests += co.tests;
+        st.near_exact_tests += co.near_tests;
+        st.adjacent_skipped += co.adjacent;
+        result.insert(result.end(), co.found.begin(), co.found.end());
+    }
+    std::sort(result.begin(), result.end());
+    return result;
+}
+
+}  // namespace
+
+Result<std::vector<TrianglePair>> quick_cullide_pairs(std::span<const Mesh> objects,
+                                                      std::span<const std::uint32_t> active,
+                                                      const QuickOptions& options, QueryDevice& device,
+                                                      QuickStats* stats) {
+    if (Status s = check_inputs(objects, active, options); !s) return s.error();
+    QuickStats st;
+    st.objects_in = active.size();
+    const auto group = static_cast<std::size_t>(options.subobject_triangles);
+    std::vector<Geom> geoms;
+    std::vector<Item> items;
+    std::vector<ItemPair> overlapping;
+
+    if (!options.self) {
+        // Stage 1: object boxes.
+        auto t0 = Clock::now();
+        std::vector<Geom> boxes(active.size());
+        std::vector<Item> box_items(active.size());
+        for (std::size_t k = 0; k < active.size(); ++k) {
+            const Aabb b = mesh_bounds(objects[active[k]]);
+            Geom& g = boxes[k];
+            g.object = active[k];
+            g.positions.resize(8);
+            for (std::size_t c = 0; c < 8; ++c)
+                g.positions[c] = {(c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z};
+            g.indices.assign(kBoxIndices.begin(), kBoxIndices.end());
+            box_items[k].geom = static_cast<std::uint32_t>(k);
+            box_items[k].first = 0;
+            box_items[k].count = 12;
+            box_items[k].box = b;
+        }
+        set_object_near(box_items);
+        if (Status s = run_stage(boxes, box_items, CullStage::Boxes, options, device, st); !s) return s.error();
+        st.pcs_boxes = count_live(box_items);
+        st.boxes_ms = ms_since(t0);
+
+        // Stage 2: whole objects (the live boxes' objects, tags inherited).
+        t0 = Clock::now();
+        for (const Item& b : box_items) {
+            if (b.tag == kBFV) continue;
+            const std::uint32_t object = boxes[b.geom].object;
+            const Mesh& m = objects[object];
+            std::vector<std::uint32_t> order(m.triangles.size());
+            for (std::size_t t = 0; t < order.size(); ++t) order[t] = static_cast<std::uint32_t>(t);
+            Item it;
+            it.geom = static_cast<std::uint32_t>(geoms.size());
+            it.first = 0;
+            it.count = static_cast<std::uint32_t>(order.size());
+            it.box = b.box;
+            it.tag = b.tag;
+            geoms.push_back(make_mesh_geom(m, object, std::move(order)));
+            items.push_back(it);
+        }
+        set_object_near(items);
+        if (Status s = run_stage(geoms, items, CullStage::Objects, options, device, st); !s) return s.error();
+        st.pcs_objects = count_live(items);
+        st.objects_ms = ms_since(t0);
+
+        // Stage 3: sub-objects; stage 4: single triangles (when sub-objects hold more than one).
+        t0 = Clock::now();
+        items = split_items(geoms, items, group);
+        set_object_near(items);
+        st.subobjects = items.size();
+        if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, device, st); !s) return s.error();
+        st.pcs_subobjects = count_live(items);
+        if (group > 1) {
+            items = split_items(geoms, items, 1);
+            set_object_near(items);
+            st.triangles_in = items.size();
+            if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, device, st); !s) return s.error();
+            st.pcs_triangles = count_live(items);
+        }
+        st.subobjects_ms = ms_since(t0);
+    } else {
+        // Self-collision: one stage over every object's sub-objects, each object's triangles in a
+        // bandwidth-reducing order, near = within the object's window.
+        auto t0 = Clock::now();
+        for (std::uint32_t object : active) {
+            const Mesh& m = objects[object];
+            std::vector<std::uint32_t> weld = weld_vertices(m);
+            const VertexTriangles vt = vertex_triangles(m, weld);
+            std::vector<std::uint32_t> input(m.triangles.size());
+            for (std::size_t t = 0; t < input.size(); ++t) input[t] = static_cast<std::uint32_t>(t);
+            std::vector<std::uint32_t> last;
+            (void)bfs_order(m, weld, vt, {}, &last);
+            std::vector<std::uint32_t> bfs = bfs_order(m, weld, vt, last, nullptr);
+            const std::uint32_t w_in = window_of(input, group, vt);
+            const std::uint32_t w_bfs = window_of(bfs, group, vt);
+            const std::uint32_t w = std::min(w_in, w_bfs);
+            st.window_max = std::max<std::uint64_t>(st.window_max, w);
+            const auto gi = static_cast<std::uint32_t>(geoms.size());
+            geoms.push_back(make_mesh_geom(m, object, w_bfs < w_in ? std::move(bfs) : std::move(input)));
+            geoms.back().weld = std::move(weld);
+            Item whole;
+            whole.geom = gi;
+            whole.count = static_cast<std::uint32_t>(m.triangles.size());
+            const std::size_t s = items.size();
+            std::vector<Item> parts = split_items(geoms, std::vector<Item>{whole}, group);
+            const std::size_t e = s + parts.size();
+            for (std::size_t k = 0; k < parts.size(); ++k) {
+                const std::size_t pos = s + k;
+                parts[k].near_lo = static_cast<std::uint32_t>(pos >= s + w ? pos - w : s);
+                parts[k].near_hi = static_cast<std::uint32_t>(std::min<std::size_t>(e - 1, pos + w));
+                items.push_back(parts[k]);
+            }
+        }
+        st.subobjects = items.size();
+        // Box pairs once (they include BFV items: their near pairs stay open); the box tags leave
+        // to the passes only the items with a far overlapping box.
+        overlapping = box_pairs(items, true);
+        if (!options.skip_visibility) box_tags(items, overlapping);
+        st.pcs_boxes = count_live(items);
+        if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, device, st); !s) return s.error();
+        st.pcs_subobjects = count_live(items);
+        st.subobjects_ms = ms_since(t0);
+    }
+
+    auto t0 = Clock::now();
+    if (!options.self) overlapping = box_pairs(items, false);
+    std::vector<TrianglePair> pairs = exact_stage(objects, geoms, items, overlapping, options, st);
+    st.exact_ms = ms_since(t0);
+    if (stats != nullptr) *stats = std::move(st);
+    return pairs;
+}
+
+}  // namespace cullide
