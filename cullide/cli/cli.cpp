@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "bench.h"
 #include "cullide/mesh_io.h"
 #include "cullide/pipeline.h"
 #include "cullide/scenes.h"
@@ -26,6 +27,8 @@ constexpr const char* kUsage =
     "commands:\n"
     "  run [SCENE...]   detect colliding triangle pairs, frame by frame\n"
     "  scenes           list the built-in scenes\n"
+    "  bench            time methods per frame, checked against the ground truth (bench --help)\n"
+    "  sweep            resolution x depth format x method x scene: time, PCS, errors (sweep --help)\n"
     "  help             this text\n"
     "\n"
     "SCENE is one built-in scene name (default: cylinders) or mesh files (.obj .ply .stl); each file is\n"
@@ -345,6 +348,7 @@ int run(const std::vector<std::string>& args, std::ostream& out, std::ostream& e
             return 0;
         }
         if (args[0] == "run") return run_command(args, out, err);
+        if (args[0] == "bench" || args[0] == "sweep") return bench_command(args, out, err);
         throw UsageError{"unknown command '" + args[0] + "'"};
     } catch (const UsageError& e) {
         err << "cullide: " << e.message << "\n(run 'cullide help' for usage)\n";
