@@ -46,4 +46,11 @@ class Digest {
     return v != nullptr && *v != '\0' && std::string_view(v) != "0";
 }
 
+// The methods of cullide::method_names() that promise never to miss a collision (pipeline.h):
+// the reliability tests assert they report exactly the ground truth. The others (exact itself, and
+// the GL-exact ones: cullide, qcullide-gl) are not in this list; a new reliable method is added here.
+[[nodiscard]] inline bool reliable_method(std::string_view method) {
+    return method == "rcullide" || method == "rcullide-offset" || method == "qcullide";
+}
+
 }  // namespace reliability
