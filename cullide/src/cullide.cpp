@@ -354,38 +354,8 @@ std::vector<raster::Double3> to_double3(const Mesh& m) {
 }
 
 Status check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active, const CullideOptions& o) {
-    if (o.resolution < 1 || o.resolution > raster::kMaxTargetSize)
-        return Error{"resolution must be in 1.." + std::to_string(raster::kMaxTargetSize) + " (got " +
-                     std::to_string(o.resolution) + ")"};
-    if (o.subobject_triangles < 1)
-        return Error{"sub-object size must be >= 1 triangle (got " + std::to_string(o.subobject_triangles) + ")"};
-    if (o.max_rounds < 1 || o.max_rounds > 1000)
-        return Error{"max_rounds must be in 1..1000 (got " + std::to_string(o.max_rounds) + ")"};
-    if (o.threads < 0) return Error{"threads must be >= 0 (got " + std::to_string(o.threads) + ")"};
-    if (Status s = validate_scene(objects); !s) return s;
-    if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
-    for (std::size_t k = 0; k < active.size(); ++k) {
-        if (active[k] >= objects.size())
-            return Error{"active object " + std::to_string(k) + " = " + std::to_string(active[k]) +
-                         " is beyond the object list (size " + std::to_string(objects.size()) + ")"};
-        if (k > 0 && active[k] <= active[k - 1])
-            return Error{"active objects must be strictly increasing (entry " + std::to_string(k) + ")"};
-        const Mesh& m = objects[active[k]];
-        if (m.triangles.size() > UINT32_MAX / 3)
-            return Error{"object " + std::to_string(active[k]) + ": too many triangles (limit 2^32 / 3)"};
-        for (std::size_t v = 0; v < m.positions.size(); ++v) {
-            for (int c = 0; c < 3; ++c) {
-                if (!predicate_coordinate_ok(m.positions[v][c])) {
-                    char value[32];
-                    std::snprintf(value, sizeof value, "%.17g", m.positions[v][c]);
-                    return Error{"object " + std::to_string(active[k]) + ": mesh '" + m.name + "': vertex " +
-                                 std::to_string(v) + " coordinate " + "xyz"[c] + " = " + value +
-                                 " is outside the exact range (0, or 2^-300 <= |x| <= 2^300)"};
-                }
-            }
-        }
-    }
-    return Status{};
+    return detail::check_visibility_inputs(objects, active, o.resolution, o.subobject_triangles, o.max_rounds,
+                                           o.threads);
 }
 
 // Surviving sub-objects paired across objects (sweep and prune on their boxes along the axis of
@@ -555,3 +525,43 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
 }
 
 }  // namespace cullide
+
+namespace cullide::detail {
+
+Status check_visibility_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active, int resolution,
+                               int subobject_triangles, int max_rounds, int threads) {
+    if (resolution < 1 || resolution > raster::kMaxTargetSize)
+        return Error{"resolution must be in 1.." + std::to_string(raster::kMaxTargetSize) + " (got " +
+                     std::to_string(resolution) + ")"};
+    if (subobject_triangles < 1)
+        return Error{"sub-object size must be >= 1 triangle (got " + std::to_string(subobject_triangles) + ")"};
+    if (max_rounds < 1 || max_rounds > 1000)
+        return Error{"max_rounds must be in 1..1000 (got " + std::to_string(max_rounds) + ")"};
+    if (threads < 0) return Error{"threads must be >= 0 (got " + std::to_string(threads) + ")"};
+    if (Status s = validate_scene(objects); !s) return s;
+    if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
+    for (std::size_t k = 0; k < active.size(); ++k) {
+        if (active[k] >= objects.size())
+            return Error{"active object " + std::to_string(k) + " = " + std::to_string(active[k]) +
+                         " is beyond the object list (size " + std::to_string(objects.size()) + ")"};
+        if (k > 0 && active[k] <= active[k - 1])
+            return Error{"active objects must be strictly increasing (entry " + std::to_string(k) + ")"};
+        const Mesh& m = objects[active[k]];
+        if (m.triangles.size() > UINT32_MAX / 3)
+            return Error{"object " + std::to_string(active[k]) + ": too many triangles (limit 2^32 / 3)"};
+        for (std::size_t v = 0; v < m.positions.size(); ++v) {
+            for (int c = 0; c < 3; ++c) {
+                if (!predicate_coordinate_ok(m.positions[v][c])) {
+                    char value[32];
+                    std::snprintf(value, sizeof value, "%.17g", m.positions[v][c]);
+                    return Error{"object " + std::to_string(active[k]) + ": mesh '" + m.name + "': vertex " +
+                                 std::to_string(v) + " coordinate " + "xyz"[c] + " = " + value +
+                                 " is outside the exact range (0, or 2^-300 <= |x| <= 2^300)"};
+                }
+            }
+        }
+    }
+    return Status{};
+}
+
+}  // namespace cullide::detail

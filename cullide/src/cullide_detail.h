@@ -1,6 +1,9 @@
 // cullide_detail.h (private): view helpers of cullide.cpp shared with quick_cullide.cpp.
 #pragma once
 
+#include <cstdint>
+#include <span>
+
 #include "cullide/cullide.h"
 #include "cullide/mesh.h"
 #include "cullide/result.h"
@@ -17,5 +20,11 @@ void widen(double& lo, double& hi);
 // world units before and after along the axis; resolution and depth format from `o`.
 [[nodiscard]] Result<raster::OrthoView> make_view(int axis, const Aabb& bounds, double extra_depth,
                                                   const CullideOptions& o);
+
+// The checks every visibility method makes before drawing anything: option ranges, a valid scene,
+// `active` strictly increasing and in range, and every active object's coordinates inside the
+// exact range (with the ground truth's message, so all methods refuse alike).
+[[nodiscard]] Status check_visibility_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                                             int resolution, int subobject_triangles, int max_rounds, int threads);
 
 }  // namespace cullide::detail

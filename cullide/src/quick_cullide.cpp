@@ -57,27 +57,8 @@ struct Item {
 Status check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active, const QuickOptions& o) {
     if (o.mode == VisibilityMode::Offset)
         return Error{"Quick-CULLIDE runs in GL-exact or exact-bounds mode, not with offset solids"};
-    if (o.resolution < 1 || o.resolution > raster::kMaxTargetSize)
-        return Error{"resolution must be in 1.." + std::to_string(raster::kMaxTargetSize) + " (got " +
-                     std::to_string(o.resolution) + ")"};
-    if (o.subobject_triangles < 1)
-        return Error{"sub-object size must be >= 1 triangle (got " + std::to_string(o.subobject_triangles) + ")"};
-    if (o.max_rounds < 1 || o.max_rounds > 1000)
-        return Error{"max_rounds must be in 1..1000 (got " + std::to_string(o.max_rounds) + ")"};
-    if (o.threads < 0) return Error{"threads must be >= 0 (got " + std::to_string(o.threads) + ")"};
-    if (Status s = validate_scene(objects); !s) return s;
-    if (Status s = validate_exact_range(objects); !s) return s;
-    if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
-    for (std::size_t k = 0; k < active.size(); ++k) {
-        if (active[k] >= objects.size())
-            return Error{"active object " + std::to_string(k) + " = " + std::to_string(active[k]) +
-                         " is beyond the object list (size " + std::to_string(objects.size()) + ")"};
-        if (k > 0 && active[k] <= active[k - 1])
-            return Error{"active objects must be strictly increasing (entry " + std::to_string(k) + ")"};
-        if (objects[active[k]].triangles.size() > UINT32_MAX / 3)
-            return Error{"object " + std::to_string(active[k]) + ": too many triangles (limit 2^32 / 3)"};
-    }
-    return Status{};
+    return detail::check_visibility_inputs(objects, active, o.resolution, o.subobject_triangles, o.max_rounds,
+                                           o.threads);
 }
 
 std::uint64_t count_live(const std::vector<Item>& items) {

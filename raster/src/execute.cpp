@@ -8,15 +8,11 @@
 #include <vector>
 
 #include "exact_bounds.h"
+#include "parallel_for.h"
 #include "pipeline.h"
 #include "raster/command_batch.h"
 #include "validate.h"
 
-#if defined(CULLIDE_HAVE_TBB)
-#include <oneapi/tbb/blocked_range.h>
-#include <oneapi/tbb/parallel_for.h>
-#include <oneapi/tbb/task_arena.h>
-#endif
 
 namespace raster {
 namespace {
@@ -60,24 +56,6 @@ void finish_results(const CommandBatch& batch, QueryResults& r) {
         if (kinds[q] == QueryKind::AnySamplesPassed) r[q] = r[q] > 0 ? 1 : 0;
 }
 
-template <class F>
-void run_parallel(int threads, std::size_t n, const F& body) {
-#if defined(CULLIDE_HAVE_TBB)
-    if (threads > 1 && n > 1) {
-        oneapi::tbb::task_arena arena(threads);
-        arena.execute([&] {
-            oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, n, 1),
-                                      [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
-                                          for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
-                                      });
-        });
-        return;
-    }
-#else
-    (void)threads;
-#endif
-    for (std::size_t i = 0; i < n; ++i) body(i);
-}
 
 }  // namespace
 
@@ -176,7 +154,7 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
             pieces.push_back({static_cast<std::uint32_t>(d), k, std::min(n, k + 3 * kFrontEndPiece)});
     }
     std::vector<std::vector<detail::SetupTri>> piece_out(pieces.size());
-    run_parallel(threads, pieces.size(), [&](std::size_t j) {
+    detail::run_parallel(threads, pieces.size(), [&](std::size_t j) {
         const std::size_t d = pieces[j].draw;
         const Command& c = cmds[draw_cmds[d]];
         const detail::FrontEndParams p = params_for(target, c.state);
@@ -207,7 +185,7 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
     // Parallel binning over bands of tile rows: each band walks every triangle in command order and
     // fills only its own tiles, so every bin is the same list for any thread count.
     const int bands = threads > 1 ? std::min(threads, tiles_y) : 1;
-    run_parallel(threads, static_cast<std::size_t>(bands), [&](std::size_t band) {
+    detail::run_parallel(threads, static_cast<std::size_t>(bands), [&](std::size_t band) {
         const int band_ty0 = static_cast<int>(static_cast<std::size_t>(tiles_y) * band / static_cast<std::size_t>(bands));
         const int band_ty1 =
             static_cast<int>(static_cast<std::size_t>(tiles_y) * (band + 1) / static_cast<std::size_t>(bands)) - 1;
@@ -255,7 +233,7 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
     const auto& query_kinds = batch.query_kinds();
     const std::unique_ptr<std::atomic<bool>[]> answered(new std::atomic<bool>[query_kinds.size() + 1]);
     for (std::size_t q = 0; q <= query_kinds.size(); ++q) answered[q].store(false, std::memory_order_relaxed);
-    run_parallel(threads, tile_count, [&](std::size_t tile) {
+    detail::run_parallel(threads, tile_count, [&](std::size_t tile) {
         const int tx = static_cast<int>(tile % static_cast<std::size_t>(tiles_x));
         const int ty = static_cast<int>(tile / static_cast<std::size_t>(tiles_x));
         const int x0 = tx * kTileSize, y0 = ty * kTileSize;

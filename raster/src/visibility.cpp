@@ -8,14 +8,10 @@
 #include <string>
 
 #include "exact_bounds.h"
+#include "parallel_for.h"
 #include "pipeline.h"
 #include "raster/depth_target.h"
 
-#if defined(CULLIDE_HAVE_TBB)
-#include <oneapi/tbb/blocked_range.h>
-#include <oneapi/tbb/parallel_for.h>
-#include <oneapi/tbb/task_arena.h>
-#endif
 
 namespace raster {
 namespace {
@@ -29,24 +25,6 @@ int tile_side(int width, int height) {
 }
 constexpr std::uint32_t kNoObject = 0xffffffffu;
 
-template <class F>
-void for_each_parallel(int threads, std::size_t n, const F& body) {
-#if defined(CULLIDE_HAVE_TBB)
-    if (threads > 1 && n > 1) {
-        oneapi::tbb::task_arena arena(threads);
-        arena.execute([&] {
-            oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, n, 1),
-                                      [&](const oneapi::tbb::blocked_range<std::size_t>& r) {
-                                          for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
-                                      });
-        });
-        return;
-    }
-#else
-    (void)threads;
-#endif
-    for (std::size_t i = 0; i < n; ++i) body(i);
-}
 
 std::string check_vertex(const Double4& d) {
     if (!std::isfinite(d.x) || !std::isfinite(d.y) || !std::isfinite(d.z) || !std::isfinite(d.w))
@@ -128,7 +106,7 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
     params.viewport = Viewport{0, 0, width, height};
     params.cull_face = CullFace::None;
     params.front_face = FrontFace::CCW;
-    for_each_parallel(threads, items.size(), [&](std::size_t i) {
+    detail::run_parallel(threads, items.size(), [&](std::size_t i) {
         auto& tris = s.tris[i];
         auto& pool = s.pool[i];
         tris.clear();
@@ -170,7 +148,7 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
 
     // Per tile: every fragment's zmin into the two minima, then every fragment's zmax against the
     // minimum over the other objects.
-    for_each_parallel(threads, tile_count, [&](std::size_t tile) {
+    detail::run_parallel(threads, tile_count, [&](std::size_t tile) {
         auto& bin = s.bins[tile];
         auto& frags = s.frags[tile];
         auto& hits = s.hits[tile];
