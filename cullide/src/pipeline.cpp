@@ -148,7 +148,7 @@ Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOption
             co.mode = options.method == Method::Cullide    ? VisibilityMode::GLExact
                       : options.method == Method::RCullide ? VisibilityMode::ExactBounds
                                                            : VisibilityMode::Offset;
-            co.resolution = options.resolution;
+            co.resolution = options.resolution == 0 ? default_resolution(options.method) : options.resolution;
             co.depth_format = options.depth_format;
             co.subobject_triangles = options.subobject_triangles;
             co.max_rounds = options.max_rounds;
@@ -184,7 +184,7 @@ Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOption
             QuickOptions qo;
             qo.mode = options.method == Method::QCullide ? VisibilityMode::ExactBounds : VisibilityMode::GLExact;
             qo.self = options.self;
-            qo.resolution = options.resolution;
+            qo.resolution = options.resolution == 0 ? default_resolution(options.method) : options.resolution;
             qo.depth_format = options.depth_format;
             qo.subobject_triangles = options.subobject_triangles;
             qo.max_rounds = options.max_rounds;

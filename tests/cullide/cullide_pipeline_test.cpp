@@ -247,10 +247,10 @@ TEST_CASE("bad options and inputs are errors that name the problem") {
     CHECK(r.error().message.find("sub-object size must be >= 1") != std::string::npos);
 
     o.subobject_triangles = 4;
-    o.resolution = 0;
+    o.resolution = -1;
     r = cullide::process_frame(objects, o);
     REQUIRE_FALSE(r.ok());
-    CHECK(r.error().message.find("resolution must be in 1..16384 (got 0)") != std::string::npos);
+    CHECK(r.error().message.find("resolution must be in 1..16384 (got -1)") != std::string::npos);
 
     o.resolution = 64;
     auto bad = objects;
@@ -356,4 +356,32 @@ TEST_CASE("a view 2^-195 thin along one axis does not overflow the offset solids
             CHECK(r.value().pairs == exact.value());
         }
     }
+}
+
+TEST_CASE("resolution 0 means each method's own default resolution") {
+    // A library user who picks another method must not silently inherit rcullide's 32 px.
+    cullide::SceneOptions so;
+    so.scale = 0.25;
+    so.mesh_dir = "";
+    auto scene = cullide::make_scene("cylinders", so);
+    REQUIRE(scene.ok());
+    const cullide::Frame objects = scene.value()->frame(0);
+    for (Method m : {Method::Cullide, Method::RCullide, Method::QCullideGL}) {
+        CAPTURE(cullide::to_string(m));
+        cullide::RunOptions implicit;
+        implicit.method = m;
+        REQUIRE(implicit.resolution == 0);
+        cullide::RunOptions explicit_res = implicit;
+        explicit_res.resolution = cullide::default_resolution(m);
+        auto a = cullide::process_frame(objects, implicit);
+        auto b = cullide::process_frame(objects, explicit_res);
+        REQUIRE(a.ok());
+        REQUIRE(b.ok());
+        CHECK(a.value().pairs == b.value().pairs);
+        CHECK(a.value().stats.queries == b.value().stats.queries);
+        CHECK(a.value().stats.pcs_subobjects == b.value().stats.pcs_subobjects);
+        CHECK(a.value().stats.triangles_rasterized == b.value().stats.triangles_rasterized);
+    }
+    // And the defaults differ where they should (rcullide low, the pixel-centre methods high).
+    CHECK(cullide::default_resolution(Method::RCullide) < cullide::default_resolution(Method::Cullide));
 }

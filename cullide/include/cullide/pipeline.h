@@ -56,9 +56,9 @@ inline constexpr int kDefaultResolutionOthers = 1024;
 struct RunOptions {
     Method method = Method::RCullide;  // R-CULLIDE (exact-bounds): never misses, ends in the exact test
     int threads = 0;          // 0 = all hardware threads; results do not depend on it
-    // View resolution of the visibility methods (pixels per side); the default is rcullide's
-    // (default_resolution: set it when choosing another method; the CLI does).
-    int resolution = kDefaultResolutionRCullide;
+    // View resolution of the visibility methods (pixels per side), 1..16384; 0 = the method's own
+    // default_resolution (so choosing another method never silently keeps rcullide's 32 px).
+    int resolution = 0;
     bool self = false;        // also report pairs inside one object (adjacent triangles excluded);
                               // exact, qcullide and qcullide-gl only (CULLIDE never tests an object
                               // against itself)
