@@ -18,11 +18,13 @@ constexpr std::uint32_t kBox[36] = {0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5,
 
 double comp(const Double3& p, int k) { return k == 0 ? p.x : (k == 1 ? p.y : p.z); }
 
-// A clip coordinate beyond +-4 lies outside the clip volume, and clamp_box pulls every box that
-// crosses it back to +-2 (x, y) or +-1 (z); so saturating at +-4 before the float conversion changes
-// no drawn pixel, keeps an entirely outside box outside, and keeps a very anisotropic view (an
-// extent of 2^-195 along one axis, a fuzzer finding) from overflowing float.
-double saturate(double v) { return std::clamp(v, -4.0, 4.0); }
+// A clip coordinate beyond +-2^64 lies far outside the clip volume, and clamp_box pulls every box
+// that crosses it back to +-2 (x, y) or +-1 (z); so saturating at +-2^64 before the float conversion
+// changes no drawn pixel, keeps an entirely outside box outside, and keeps a very anisotropic view
+// (an extent of 2^-195 along one axis, a fuzzer finding) from overflowing float. The bound is far
+// from +-1 on purpose: cullide.cpp widens the depth range by the solids' measured overshoot, which a
+// bound near 1 would cap (a second fuzzer finding: 8 widening steps were not enough).
+double saturate(double v) { return std::clamp(v, -0x1p64, 0x1p64); }
 
 float round_down(double v) {
     v = saturate(v);
