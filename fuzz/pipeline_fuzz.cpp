@@ -3,7 +3,8 @@
 // vertex pool so degenerate and fan triangles occur), coordinates on a quarter grid or raw within a
 // sane range, and touching / near-touching constructions (a triangle copied from an earlier object,
 // an earlier object translated by a grid step, or an earlier object moved by a few ulps), plus a
-// resolution (16..256), depth format, sub-object size, rounds and broad phase.
+// resolution (16..256), depth format, sub-object size, rounds, broad phase, and either the methods'
+// default stage rules or the published ones (object stage on, stop when nothing more is pruned).
 // Property (R-CULLIDE's guarantee, Govindaraju et al., "Fast reliable collision culling using
 // graphics hardware", 2004): the culling never drops a colliding pair and the exact stage removes
 // every false positive, so process_frame with rcullide and rcullide-offset returns exactly the
@@ -123,9 +124,13 @@ void print_scene(const std::vector<Mesh>& scene) {
 }
 
 [[noreturn]] void fail(const std::vector<Mesh>& scene, const cullide::RunOptions& opt, const std::string& what) {
-    std::fprintf(stderr, "pipeline_fuzz: property violated (%s, resolution %d, %s, subobject %d, rounds %d, %s): %s\n",
+    std::fprintf(stderr,
+                 "pipeline_fuzz: property violated (%s, resolution %d, %s, subobject %d, rounds %d, min_prune %g, "
+                 "object stage %s, %s): %s\n",
                  cullide::to_string(opt.method), opt.resolution, cullide::to_string(opt.depth_format),
-                 opt.subobject_triangles, opt.max_rounds, cullide::to_string(opt.broadphase), what.c_str());
+                 opt.subobject_triangles, opt.max_rounds, opt.min_prune,
+                 opt.object_stage == cullide::ObjectStage::On ? "on" : "auto", cullide::to_string(opt.broadphase),
+                 what.c_str());
     print_scene(scene);
     std::abort();
 }
@@ -146,6 +151,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     opt.depth_format = static_cast<raster::DepthFormat>(head % 3U);
     opt.subobject_triangles = 1 + (head >> 2) % 4;
     opt.max_rounds = 1 + (head >> 4) % 4;
+    if ((head & 0x80U) != 0) {  // the published stage rules instead of rcullide's defaults
+        opt.object_stage = cullide::ObjectStage::On;
+        opt.min_prune = 0.0;
+    }
     opt.broadphase = static_cast<cullide::BroadPhase>(r.byte() % 4U);
     const bool raw = (head & 0x40U) != 0;
     const std::vector<Mesh> scene = decode_scene(r, raw);

@@ -55,7 +55,8 @@ constexpr const char* kBenchUsage =
     "  --frame-step K        frame index step, 1..100000 (default 1)\n"
     "  --warmup N            untimed runs per frame, 0..1000 (default 1)\n"
     "  --reps N              timed runs per frame, 1..1000 (default 5)\n"
-    "  --subobject N, --rounds N, --broadphase B, --self, --seed S, --mesh-dir DIR: as 'cullide run'\n"
+    "  --subobject N, --rounds N, --min-prune F, --object-stage S, --broadphase B, --self, --seed S,\n"
+    "  --mesh-dir DIR: as 'cullide run'\n"
     "  --csv FILE            write one CSV row per combination ('-' = stdout)\n"
     "  --json FILE           write a JSON document ('-' = stdout)\n"
     "  --no-progress         no progress bar (it is drawn on stderr only when stderr is a terminal)\n"
@@ -178,6 +179,17 @@ BenchArgs parse_args(const std::vector<std::string>& args) {
             a.base.subobject_triangles = int_in(o, value(i), 1, 65536);
         } else if (o == "--rounds") {
             a.base.max_rounds = int_in(o, value(i), 1, 1000);
+        } else if (o == "--min-prune") {
+            const std::string& v = value(i);
+            auto x = parse_real(v);
+            if (!x || !(*x >= 0) || !(*x < 1)) throw BenchUsageError{"--min-prune must be a number in [0, 1) (got '" + v + "')"};
+            a.base.min_prune = *x;
+        } else if (o == "--object-stage") {
+            const std::string& v = value(i);
+            if (v == "auto") a.base.object_stage = ObjectStage::Auto;
+            else if (v == "on") a.base.object_stage = ObjectStage::On;
+            else if (v == "off") a.base.object_stage = ObjectStage::Off;
+            else throw BenchUsageError{"--object-stage must be auto, on or off (got '" + v + "')"};
         } else if (o == "--broadphase") {
             Result<BroadPhase> b = parse_broadphase(value(i));
             if (!b) throw BenchUsageError{"--broadphase: " + b.error().message};
@@ -314,7 +326,9 @@ void write_json(std::ostream& o, const BenchArgs& a, const std::vector<CaseResul
       << ", \"frames\": " << a.frames << ", \"first_frame\": " << a.first_frame << ", \"frame_step\": "
       << a.frame_step << ", \"warmup\": " << a.warmup << ", \"reps\": " << a.reps << ", \"seed\": "
       << a.scene_options.seed << ", \"subobject\": " << a.base.subobject_triangles << ", \"rounds\": "
-      << a.base.max_rounds << ", \"broadphase\": \"" << to_string(a.base.broadphase) << "\", \"self\": " << (a.base.self ? "true" : "false")
+      << a.base.max_rounds << ", \"min_prune\": " << a.base.min_prune << ", \"object_stage\": \""
+      << (a.base.object_stage == ObjectStage::Auto ? "auto" : a.base.object_stage == ObjectStage::On ? "on" : "off")
+      << "\", \"broadphase\": \"" << to_string(a.base.broadphase) << "\", \"self\": " << (a.base.self ? "true" : "false")
       << ", \"cases\": [";
     for (std::size_t i = 0; i < cases.size(); ++i) {
         const CaseResult& c = cases[i];

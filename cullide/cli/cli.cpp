@@ -47,6 +47,11 @@ constexpr const char* kUsage =
     "  --depth-format F  depth buffer of visibility methods: d16, d24 (default), d32f\n"
     "  --subobject N     triangles per sub-object of visibility methods, 1..65536 (default 4)\n"
     "  --rounds N        rounds of x, y, z views per visibility stage, 1..1000 (default 4)\n"
+    "  --min-prune F     a stage stops after three views in a row that each prune less than F of\n"
+    "                    its live triangles, 0 <= F < 1 (default 0.5 for rcullide, 0 for cullide and\n"
+    "                    rcullide-offset: stop when nothing more is pruned)\n"
+    "  --object-stage S  auto (default: off for rcullide, whose sub-object views prune every object\n"
+    "                    an object view would; on for cullide and rcullide-offset), on, off\n"
     "  --broadphase B    first stage on object boxes: none (default), spatialhash, sap, brute;\n"
     "                    objects overlapping no other box are dropped at once\n"
     "  --self            also report pairs inside one object (adjacent triangles excluded); methods\n"
@@ -155,6 +160,17 @@ RunArgs parse_run_args(const std::vector<std::string>& args) {
             auto n = parse_integer<int>(v);
             if (!n || *n < 1 || *n > 1000) throw UsageError{"--rounds must be an integer in 1..1000 (got '" + v + "')"};
             r.options.max_rounds = *n;
+        } else if (a == "--min-prune") {
+            const std::string& v = need_value(i);
+            auto x = parse_double(v);
+            if (!x || !(*x >= 0) || !(*x < 1)) throw UsageError{"--min-prune must be a number in [0, 1) (got '" + v + "')"};
+            r.options.min_prune = *x;
+        } else if (a == "--object-stage") {
+            const std::string& v = need_value(i);
+            if (v == "auto") r.options.object_stage = ObjectStage::Auto;
+            else if (v == "on") r.options.object_stage = ObjectStage::On;
+            else if (v == "off") r.options.object_stage = ObjectStage::Off;
+            else throw UsageError{"--object-stage must be auto, on or off (got '" + v + "')"};
         } else if (a == "--self") {
             r.options.self = true;
         } else if (a == "--pairs") {
@@ -298,8 +314,10 @@ int run_command(const std::vector<std::string>& args, std::ostream& out, std::os
                     << " ms" << std::defaultfloat << "\n";
             }
             if (visibility) {
+                const bool object_views = std::any_of(s.views.begin(), s.views.end(),
+                                                      [](const ViewStats& v) { return v.stage == CullStage::Objects; });
                 out << "  pcs: boxes " << s.broadphase_objects << " -> " << s.pcs_boxes << " objects, triangles -> "
-                    << s.pcs_objects << " objects, sub-objects " << s.subobjects << " -> " << s.pcs_subobjects
+                    << s.pcs_objects << " objects" << (object_views ? "" : " (stage skipped)") << ", sub-objects " << s.subobjects << " -> " << s.pcs_subobjects
                     << "; " << s.subobject_pairs << " sub-object pairs; " << s.queries << " queries, "
                     << s.triangles_rasterized << " triangles rasterized, " << s.views.size() << " views\n"
                     << "  ms: boxes " << std::fixed << std::setprecision(2) << s.boxes_ms << ", objects "

@@ -151,6 +151,13 @@ std::uint64_t count_live(const std::vector<ObjectGeometry>& g) {
     return n;
 }
 
+std::uint64_t count_live_triangles(const std::vector<ObjectGeometry>& g) {
+    std::uint64_t n = 0;
+    for (const ObjectGeometry& og : g)
+        for (const Item& it : og.items) n += it.live ? it.index_count / 3 : 0;
+    return n;
+}
+
 bool has_live(const ObjectGeometry& og) {
     return std::any_of(og.items.begin(), og.items.end(), [](const Item& it) { return it.live; });
 }
@@ -278,13 +285,16 @@ Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_
     }
 }
 
-// Views along x, y, z in turn until three views in a row prune nothing (then the PCS, and so every
-// further view, is unchanged) or 3 * max_rounds views ran.
+// Views along x, y, z in turn until three views in a row are unproductive (CullideOptions::min_prune;
+// with 0, three views that prune nothing: then the PCS, and so every further view, is unchanged) or
+// 3 * max_rounds views ran.
 Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideOptions& o, QueryDevice& device,
                  CullideStats& st, raster::VisibilityPass& fused) {
     const int res = o.resolution;
     const int emulator_threads = detail::emulator_threads(device);
     const bool use_fused = o.fused_visibility && o.mode == VisibilityMode::ExactBounds && emulator_threads > 0;
+    const double min_prune =
+        o.min_prune >= 0.0 ? o.min_prune : o.mode == VisibilityMode::ExactBounds ? kDefaultMinPruneExactBounds : 0.0;
     int quiet = 0;
     for (int view = 0; view < 3 * o.max_rounds && quiet < 3; ++view) {
         std::vector<std::size_t> order;
@@ -306,6 +316,13 @@ Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideO
         vs.stage = stage;
         vs.axis = axis;
         vs.items_before = count_live(g);
+        const std::uint64_t tris_before = count_live_triangles(g);
+        // Unproductive: pruned fewer triangles than min_prune of those live (none pruned: always).
+        const auto unproductive = [&] {
+            const std::uint64_t pruned_tris = tris_before - count_live_triangles(g);
+            return pruned_tris == 0 ||
+                   static_cast<double>(pruned_tris) < min_prune * static_cast<double>(tris_before);
+        };
         if (use_fused) {
             Result<std::uint64_t> pruned = fused_view(g, order, o, emulator_threads, fused, vs);
             if (!pruned) return pruned.error();
@@ -313,7 +330,7 @@ Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideO
             st.queries += vs.queries;
             st.triangles_rasterized += vs.triangles_rasterized;
             st.views.push_back(vs);
-            quiet = pruned.value() == 0 ? quiet + 1 : 0;
+            quiet = unproductive() ? quiet + 1 : 0;
             continue;
         }
         std::array<raster::QueryResults, 2> results;
@@ -342,7 +359,7 @@ Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideO
         st.queries += vs.queries;
         st.triangles_rasterized += vs.triangles_rasterized;
         st.views.push_back(vs);
-        quiet = pruned == 0 ? quiet + 1 : 0;
+        quiet = unproductive() ? quiet + 1 : 0;
     }
     return Status{};
 }
@@ -354,6 +371,11 @@ std::vector<raster::Double3> to_double3(const Mesh& m) {
 }
 
 Status check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active, const CullideOptions& o) {
+    if (!(o.min_prune < 1.0))  // NaN too
+        return Error{"min_prune must be below 1 (negative: the mode's default; got " + std::to_string(o.min_prune) +
+                     ")"};
+    if (o.object_stage != ObjectStage::Auto && o.object_stage != ObjectStage::On && o.object_stage != ObjectStage::Off)
+        return Error{"object_stage is not Auto, On or Off"};
     return detail::check_visibility_inputs(objects, active, o.resolution, o.subobject_triangles, o.max_rounds,
                                            o.threads);
 }
@@ -487,7 +509,10 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
         og.items.push_back({0, static_cast<std::uint32_t>(og.indices.size()), b.items[0].box, true, {}});
         whole.push_back(std::move(og));
     }
-    if (Status s = run_stage(whole, CullStage::Objects, options, device, st, fused); !s) return s.error();
+    const bool object_stage = options.object_stage == ObjectStage::On ||
+                              (options.object_stage == ObjectStage::Auto && options.mode != VisibilityMode::ExactBounds);
+    if (object_stage)
+        if (Status s = run_stage(whole, CullStage::Objects, options, device, st, fused); !s) return s.error();
     st.pcs_objects = count_live(whole);
     st.objects_ms = ms_since(t0);
 

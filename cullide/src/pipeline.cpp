@@ -152,6 +152,8 @@ Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOption
             co.depth_format = options.depth_format;
             co.subobject_triangles = options.subobject_triangles;
             co.max_rounds = options.max_rounds;
+            co.min_prune = options.min_prune;
+            co.object_stage = options.object_stage;
             co.threads = options.threads;
             std::unique_ptr<QueryDevice> own;
             QueryDevice* device = options.device;

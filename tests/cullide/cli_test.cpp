@@ -158,6 +158,14 @@ TEST_CASE("bad visibility options are usage errors naming the option and the val
     CHECK(has(o.err, "--subobject must be an integer in 1..65536 (got '0')"));
     o = run({"run", "--rounds", "x"});
     CHECK(o.status == 2);
+    o = run({"run", "--min-prune", "1"});
+    CHECK(o.status == 2);
+    CHECK(has(o.err, "--min-prune must be a number in [0, 1) (got '1')"));
+    o = run({"run", "--min-prune", "nan"});
+    CHECK(o.status == 2);
+    o = run({"run", "--object-stage", "maybe"});
+    CHECK(o.status == 2);
+    CHECK(has(o.err, "--object-stage must be auto, on or off (got 'maybe')"));
     o = run({"run", "--method", "magic"});
     CHECK(has(o.err, "(valid: exact, cullide, rcullide, rcullide-offset, qcullide, qcullide-gl)"));
     o = run({"run", "--method", "cullide", "--self", "--scale", "0.05", "--frames", "1"});
@@ -186,6 +194,20 @@ TEST_CASE("a visibility method prints its PCS figures in text and in JSON, and f
     CHECK(has(text.out, "  pcs: boxes "));
     CHECK(has(text.out, " queries, "));
     CHECK(has(text.out, "  broad phase: "));
+
+    // rcullide skips the object stage by default (its sub-object views subsume it) and says so;
+    // forced on, the object views run; both with any --min-prune still give the exact pairs.
+    Outcome skipped = with({"--method", "rcullide"});
+    REQUIRE(skipped.status == 0);
+    CHECK(has(skipped.out, count + " colliding triangle pairs"));
+    CHECK(has(skipped.out, " objects (stage skipped), sub-objects "));
+    Outcome forced = with({"--method", "rcullide", "--object-stage", "on", "--min-prune", "0", "--json"});
+    REQUIRE(forced.status == 0);
+    CHECK(has(forced.out, "\"stage\": \"objects\""));
+    Outcome eager = with({"--method", "rcullide", "--object-stage", "off", "--min-prune", "0.99"});
+    REQUIRE(eager.status == 0);
+    CHECK(has(eager.out, count + " colliding triangle pairs"));
+    CHECK_FALSE(has(text.out, "(stage skipped)"));  // rcullide-offset keeps the object stage
 
     Outcome json = with({"--method", "cullide", "--json"});
     REQUIRE(json.status == 0);

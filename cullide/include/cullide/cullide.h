@@ -9,9 +9,11 @@
 // Stages of one frame (each conservative with respect to the one before it):
 //  1. object boxes: each object's axis-aligned box (12 triangles) through the two passes of
 //     Lemma 2, in orthographic views along x, y, z fitted to the bounds of the live PCS, in rounds
-//     cycling the axis until three views in a row prune nothing (a fixpoint: the same PCS gives the
-//     same view) or 3 * max_rounds views ran;
-//  2. objects: the same with each object's triangles;
+//     cycling the axis until three views in a row are unproductive (min_prune below; with 0, until
+//     three views prune nothing: a fixpoint, the same PCS gives the same view) or 3 * max_rounds
+//     views ran;
+//  2. objects: the same with each object's triangles (skipped by default for ExactBounds: see
+//     ObjectStage);
 //  3. sub-objects: each live object split into groups of `subobject_triangles` consecutive
 //     triangles; in each pass all sub-objects of an object are queried before any is written;
 //  4. exact: surviving sub-objects paired across objects by box overlap (sweep and prune), then
@@ -62,6 +64,15 @@ enum class VisibilityMode : std::uint8_t {
 };
 
 enum class CullStage : std::uint8_t { Boxes, Objects, SubObjects };
+
+// Stage 2 (whole objects). A sub-object view prunes every object that an object view of the same
+// PCS would prune (an object's fragments are the union of its sub-objects', tested against the same
+// depths, so the object is fully visible iff each of its sub-objects is), and rasterizes the same
+// triangles; it only issues more queries, which costs on a real GPU and nothing on the emulator.
+// Auto: run stage 2 for GLExact and Offset (the published pipelines, reproduced with their misses)
+// and skip it for ExactBounds (R-CULLIDE on the emulator), where it only costs views.
+enum class ObjectStage : std::uint8_t { Auto, On, Off };
+inline constexpr double kDefaultMinPruneExactBounds = 0.5;
 [[nodiscard]] const char* to_string(CullStage s);
 
 // One orthographic view (both passes).
@@ -80,6 +91,14 @@ struct CullideOptions {
     raster::DepthFormat depth_format = raster::DepthFormat::D24;
     int subobject_triangles = 4;  // triangles per sub-object, >= 1
     int max_rounds = 4;           // rounds of three views per stage, >= 1
+    // A view counts as unproductive when the triangles of the items it prunes are fewer than this
+    // fraction of the stage's live triangles before it; a stage stops after three unproductive
+    // views in a row (one per axis). 0: stop only when three views in a row prune nothing (the
+    // published rule). Negative: the mode's default, kDefaultMinPruneExactBounds for ExactBounds
+    // (measured in docs/cullide.md: later views cost as much as the first and prune little, while
+    // the exact stage absorbs what they would have pruned) and 0 for GLExact and Offset.
+    double min_prune = -1.0;      // < 1
+    ObjectStage object_stage = ObjectStage::Auto;
     int threads = 0;              // exact stage workers; 0 = all hardware threads
     // ExactBounds on the emulator device: answer each view's two passes with one fused
     // raster::VisibilityPass (raster/visibility.h: the same answers, bit for bit, at a quarter of the

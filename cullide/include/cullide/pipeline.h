@@ -65,6 +65,8 @@ struct RunOptions {
     raster::DepthFormat depth_format = raster::DepthFormat::D24;  // visibility methods
     int subobject_triangles = 4;  // triangles per sub-object (visibility methods), >= 1
     int max_rounds = 4;           // rounds of x, y, z views per visibility stage, >= 1
+    double min_prune = -1.0;      // CullideOptions::min_prune (cullide, rcullide, rcullide-offset)
+    ObjectStage object_stage = ObjectStage::Auto;  // CullideOptions::object_stage (same methods)
     BroadPhase broadphase = BroadPhase::None;  // with self on, no object is dropped by it
     // Where the visibility passes run; nullptr: the built-in emulator with `threads` workers.
     // Not owned; must outlive the call. Used by tests and benchmarks to run on a real GL.
