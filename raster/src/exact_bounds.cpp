@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace raster::detail {
@@ -57,8 +58,6 @@ constexpr double kClipMarginRel = pow2m(40);  // clip units per unit of the tria
 constexpr double kPixelMargin = pow2m(20);    // pixels, for the window-space steps (|X| < 2^16)
 constexpr double kDepthMargin = pow2m(40);    // window depth, for the window-space steps
 
-constexpr double kFracGuard = pow2m(27);  // > 2^-29, the rounding error of z * n for n < 2^24
-
 // floor and ceil without a libm call on baseline x86-64 (equal to std::floor / std::ceil for every
 // finite x, up to the sign of a zero result: |x| >= 2^52 is already an integer).
 double exact_floor(double x) {
@@ -72,52 +71,129 @@ double exact_ceil(double x) {
     return t < x ? t + 1.0 : t;
 }
 
-std::uint32_t unorm_max(DepthFormat f) { return f == DepthFormat::D16 ? 0xffffu : 0xffffffu; }
-
 }  // namespace
 
-std::uint32_t quantize_down(double z, DepthFormat format) {
-    z = z > 0.0 ? z : 0.0;
-    z = z < 1.0 ? z : 1.0;
-    if (format == DepthFormat::D32F) {
-        float f = static_cast<float>(z);
-        if (static_cast<double>(f) > z) f = std::nextafter(f, -1.0f);
-        return std::bit_cast<std::uint32_t>(f);
+namespace {
+
+// Error-bound constants of the plane path (docs/reliable-raster.md, "The plane path"); each is at
+// least 2^4 times the rounding error it covers.
+constexpr double kPlaneEdgeErr = pow2m(44);   // edge function: relative to its magnitude bound
+constexpr double kPlaneDepthErr = pow2m(44);  // plane value: relative to its magnitude bound
+constexpr double kRoundUp = 1.0 + pow2m(48);  // > (1 + 2^-53)^2: a sum of two roundings, upward
+constexpr int kPlaneMinBoxPixels = 4;  // pixel boxes up to this many pixels take the general path
+// Tightness limits: beyond them the general path is taken (a looser bound would still be correct).
+constexpr double kPlaneMaxSlackPx = pow2m(20);  // edge slack, in pixels
+constexpr double kPlaneMaxDepthErr = pow2m(36); // depth widening beyond the square's own range
+
+// Chooses the per-pixel path of a (non-single) polygon `win` of n vertices with pixel box
+// [t.x0, t.x1] x [t.y0, t.y1]; fills t.kind and, for the plane path, `plane`.
+void classify_bounds_triangle(BoundsTri& t, const BoundsVertex* win, int n, BoundsPlane& plane) {
+    // Column path: every vertex has the same X, or every column of the pixel box holds the whole
+    // polygon's X range in its grown interval [px - m, px + 1 + m] (thin triangles one or two
+    // columns wide). Then the part of the polygon above a pixel's grown square is its part over the
+    // row slab, whose depth range the column path reads off the boundary. Row path: the same with
+    // X and Y exchanged. (The bounds are computed as bounds_pixels computes them.)
+    const double m = t.margin_xy;
+    double minx = win[0].x, maxx = minx, miny = win[0].y, maxy = miny;
+    for (int i = 1; i < n; ++i) {
+        minx = std::min(minx, win[i].x);
+        maxx = std::max(maxx, win[i].x);
+        miny = std::min(miny, win[i].y);
+        maxy = std::max(maxy, win[i].y);
     }
-    const double n = static_cast<double>(unorm_max(format));
-    const double q = z * n;
-    // 0 <= q < 2^24: truncation is the floor (and avoids a libm call on baseline x86-64).
-    double v = static_cast<double>(static_cast<std::int64_t>(q));
-    // q errs by <= 2^-29 (half an ulp below 2^24), so unless q is that close to an integer its floor
-    // is the exact one (q - v is exact). Otherwise correct exactly: the sign of fma(z, n, -v) is
-    // the sign of z * n - v.
-    const double frac = q - v;
-    if (frac >= kFracGuard && frac <= 1.0 - kFracGuard) return static_cast<std::uint32_t>(v);
-    if (std::fma(z, n, -v) < 0.0) v -= 1.0;
-    if (std::fma(z, n, -(v + 1.0)) >= 0.0) v += 1.0;
-    v = std::clamp(v, 0.0, n);
-    return static_cast<std::uint32_t>(v);
+    if (minx == maxx ||
+        (static_cast<double>(t.x1) - m <= minx && maxx <= static_cast<double>(t.x0) + 1.0 + m)) {
+        t.kind = BoundsTri::Kind::Column;
+        return;
+    }
+    if (miny == maxy ||
+        (static_cast<double>(t.y1) - m <= miny && maxy <= static_cast<double>(t.y0) + 1.0 + m)) {
+        t.kind = BoundsTri::Kind::Row;
+        return;
+    }
+    if (n != 3) return;  // clipped polygons (and segments) take the general path
+    // Small boxes: the general path is about as fast there and exact on partly covered pixels.
+    if ((t.x1 - t.x0 + 1) * (t.y1 - t.y0 + 1) <= kPlaneMinBoxPixels) return;
+    // Local coordinates relative to the anchor pixel (x0, y0): each is one rounding (<= 2^-53 * 2^17
+    // = 2^-36 pixels) away from the window vertex; the triangle T'' of these local vertices is what
+    // the tests below bound (docs: that drift is far inside margin_xy).
+    const double ax = static_cast<double>(t.x0), ay = static_cast<double>(t.y0);
+    double lx[3], ly[3], lz[3];
+    // P bounds |local coordinate| of the vertices and of every point of every grown pixel square
+    // of the box: [-m, (x1 - x0) + 1 + m] (m is large only for huge inputs, M >= 2^30 or so, whose
+    // clipped polygon may still have 3 vertices; the bounds below then refuse the path).
+    double big = static_cast<double>(std::max(t.x1 - t.x0, t.y1 - t.y0)) + 2.0 + 2.0 * m;
+    for (int i = 0; i < 3; ++i) {
+        lx[i] = win[i].x - ax;
+        ly[i] = win[i].y - ay;
+        lz[i] = win[i].z;
+        big = std::max({big, std::fabs(lx[i]), std::fabs(ly[i])});
+    }
+    const double dx1 = lx[1] - lx[0], dy1 = ly[1] - ly[0], dz1 = lz[1] - lz[0];
+    const double dx2 = lx[2] - lx[0], dy2 = ly[2] - ly[0], dz2 = lz[2] - lz[0];
+    const double area = dx1 * dy2 - dy1 * dx2;  // twice the signed area (rounded)
+    if (!(std::fabs(area) > 0.0) || !std::isfinite(area)) return;
+    const double sgn = area > 0.0 ? 1.0 : -1.0;
+    BoundsPlane d;  // every field is set below before it is stored
+    for (int i = 0; i < 3; ++i) {
+        const int j = i == 2 ? 0 : i + 1;
+        // E(x, y) = A x + B y + C, >= 0 on the inner side of edge (i, j) when the orientation is
+        // right; the slack eta below makes the half-plane hold all three vertices regardless.
+        const double a = sgn * (ly[i] - ly[j]);
+        const double b = sgn * (lx[j] - lx[i]);
+        const double c = -(a * lx[i] + b * ly[i]);
+        // err bounds the rounding of every evaluation of E (vertices, corners) and of the corner
+        // constant: fewer than 16 roundings, each <= 2^-53 of a magnitude <= this bound.
+        const double err = kPlaneEdgeErr * ((std::fabs(a) + std::fabs(b)) * big + std::fabs(c));
+        double eta = 0.0;  // -min over the vertices of E (computed), at least 0
+        for (int k = 0; k < 3; ++k) eta = std::max(eta, -(a * lx[k] + b * ly[k] + c));
+        eta = (eta + err) * kRoundUp;  // exact E at every vertex >= -eta
+        if (!(eta <= kPlaneMaxSlackPx * (std::fabs(a) + std::fabs(b)))) return;  // orientation unsure / sliver
+        // The maximum of E over the grown square [lx - m, lx + 1 + m] x [ly - m, ly + 1 + m] is
+        // A lx + B ly + (C + max(A (1 + m), -A m) + max(B (1 + m), -B m)).
+        const double ox = a > 0.0 ? a * (1.0 + m) : -a * m;
+        const double oy = b > 0.0 ? b * (1.0 + m) : -b * m;
+        d.ea[i] = a;
+        d.inv_a[i] = a != 0.0 ? 1.0 / a : 0.0;
+        d.eb[i] = b;
+        d.ek[i] = c + ox + oy;
+        // Dropped when the computed maximum < et: then the exact maximum < -eta <= E everywhere on
+        // the triangle (computed + err < et + err <= -eta).
+        d.et[i] = -((eta + err) * kRoundUp);
+        if (!std::isfinite(d.ek[i]) || !std::isfinite(d.et[i])) return;
+    }
+    // Plane through the three local vertices: z = z0 + gx (x - x0) + gy (y - y0); stored as the
+    // value at the centre of the anchor pixel, pz = z0 + gx (0.5 - x0) + gy (0.5 - y0). Whatever its
+    // rounding, the vertex residuals below bound how far this plane P' is from the triangle's.
+    const double gx = (dz1 * dy2 - dz2 * dy1) / area;
+    const double gy = (dx1 * dz2 - dx2 * dz1) / area;
+    const double pz = lz[0] + gx * (0.5 - lx[0]) + gy * (0.5 - ly[0]);
+    if (!std::isfinite(gx) || !std::isfinite(gy) || !std::isfinite(pz)) return;
+    const double g = std::fabs(gx) + std::fabs(gy);
+    // Magnitude bound of every plane evaluation (vertices, pixel centres, the +- widening).
+    const double zmag = 2.0 + std::fabs(pz) + g * (big + 1.0);
+    const double zerr = kPlaneDepthErr * zmag;
+    double res = 0.0;  // max |z_k - P'(vertex k)| (computed; its own rounding is inside zerr)
+    for (int k = 0; k < 3; ++k)
+        res = std::max(res, std::fabs(lz[k] - (pz + gx * (lx[k] - 0.5) + gy * (ly[k] - 0.5))));
+    const double extra = (res + 2.0 * zerr) * kRoundUp;  // residual + evaluation errors
+    if (!(extra <= kPlaneMaxDepthErr)) return;
+    d.pz = pz;
+    d.pgx = gx;
+    d.pgy = gy;
+    // P' over the grown square: centre value +- (|gx| + |gy|) (1/2 + m).
+    d.pw = (g * (0.5 + m) + extra) * kRoundUp * kRoundUp;
+    d.pzlo = std::min({lz[0], lz[1], lz[2]});
+    d.pzhi = std::max({lz[0], lz[1], lz[2]});
+    // A slab range's crossing z = zp + (s - tp) * slope, clamped to the edge's depth range, is
+    // within 4 roundings of (|zp| + |dz|) <= 3 max|z| of the exact crossing of the (window) edge.
+    d.sw = kPlaneDepthErr * (3.0 * std::max(std::fabs(d.pzlo), std::fabs(d.pzhi)) + 1.0);
+    if (!std::isfinite(d.pw)) return;
+    plane = d;
+    t.kind = BoundsTri::Kind::Plane;
 }
 
-std::uint32_t quantize_up(double z, DepthFormat format) {
-    z = z > 0.0 ? z : 0.0;
-    z = z < 1.0 ? z : 1.0;
-    if (format == DepthFormat::D32F) {
-        float f = static_cast<float>(z);
-        if (static_cast<double>(f) < z) f = std::nextafter(f, 2.0f);
-        return std::bit_cast<std::uint32_t>(f);
-    }
-    const double n = static_cast<double>(unorm_max(format));
-    const double q = z * n;
-    double v = static_cast<double>(static_cast<std::int64_t>(q));
-    if (v < q) v += 1.0;        // the ceiling
-    const double frac = v - q;  // exact, as above
-    if (frac >= kFracGuard && frac <= 1.0 - kFracGuard) return static_cast<std::uint32_t>(v);
-    if (std::fma(z, n, -v) > 0.0) v += 1.0;
-    if (std::fma(z, n, -(v - 1.0)) <= 0.0) v -= 1.0;
-    v = std::clamp(v, 0.0, n);
-    return static_cast<std::uint32_t>(v);
-}
+}  // namespace
 
 void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const Double4& b, const Double4& c,
                            std::uint32_t draw, std::vector<BoundsTri>& out, std::vector<BoundsVertex>& pool) {
@@ -191,16 +267,23 @@ void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const
     t.x1 = static_cast<int>(std::min(bx1, w1));
     t.y1 = static_cast<int>(std::min(by1, h1));
     t.single = bx0 == bx1 && by0 == by1;
+    BoundsPlane plane;
+    if (!t.single) classify_bounds_triangle(t, win, n, plane);
     t.first = static_cast<std::uint32_t>(pool.size());
     pool.insert(pool.end(), win, win + n);
+    if (t.kind == BoundsTri::Kind::Plane) {
+        BoundsVertex slots[kPlaneSlots];
+        std::memcpy(static_cast<void*>(slots), &plane, sizeof plane);
+        pool.insert(pool.end(), slots, slots + kPlaneSlots);
+    }
     out.push_back(t);
 }
 
 namespace {
 
-template <class T>
-bool depth_pass(DepthFunc f, T incoming, T stored) {
-    switch (f) {
+template <DepthFunc F, class T>
+inline bool depth_pass(T incoming, T stored) {
+    switch (F) {
         case DepthFunc::Never:
             return false;
         case DepthFunc::Less:
@@ -221,30 +304,97 @@ bool depth_pass(DepthFunc f, T incoming, T stored) {
     return false;
 }
 
-}  // namespace
-
-std::uint64_t bounds_rect(const BoundsTri& tri, const BoundsVertex* pool, DepthFormat format, DepthFunc func,
-                          bool write, std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1) {
+// bounds_rect for one depth function and format class (D32F compares floats, D16/D24 integers):
+// the per-pixel callback is then a few instructions, inlined into the traversal.
+template <DepthFunc F, bool D32F>
+std::uint64_t bounds_rect_impl(const BoundsTri& tri, const BoundsVertex* pool, DepthFormat format, bool write,
+                               std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1) {
     std::uint64_t passed = 0;
-    const bool d32f = format == DepthFormat::D32F;
+    const double mz = tri.margin_z;
+    const auto pass_at = [](std::uint32_t in, std::uint32_t st) __attribute__((always_inline)) {
+        if constexpr (D32F)
+            return depth_pass<F>(std::bit_cast<float>(in), std::bit_cast<float>(st));
+        else
+            return depth_pass<F>(in, st);
+    };
+    // Constant depth (screen-parallel faces): the plane path gives every covered pixel exactly [z, z]
+    // (the clamp to the vertex range [z, z]), so one quantized value for the triangle and a plain
+    // loop over each row's span: the same values as the traversal below.
+    const bool flat_plane = tri.kind == BoundsTri::Kind::Plane && pool[tri.first].z == pool[tri.first + 1].z &&
+                            pool[tri.first].z == pool[tri.first + 2].z;
+    if (flat_plane) {
+        const BoundsPlane d = load_plane(tri, pool);
+        const std::uint32_t in = write ? quantize_down(d.pzlo - mz, format) : quantize_up(d.pzhi + mz, format);
+        const int ys = std::max(ry0, tri.y0), ye = std::min(ry1, tri.y1);
+        const int xs = std::max(rx0, tri.x0), xe = std::min(rx1, tri.x1);
+        for (int py = ys; py <= ye; ++py) {
+            int lo = xs - tri.x0, hi = xe - tri.x0;
+            plane_row_span(d, static_cast<double>(py - tri.y0), lo, hi);
+            std::uint32_t* row = depth + static_cast<std::size_t>(py) * static_cast<std::size_t>(stride) +
+                                 static_cast<std::size_t>(tri.x0);
+            std::uint64_t n = 0;
+            if (write) {
+                for (int x = lo; x <= hi; ++x) {
+                    const bool p = pass_at(in, row[x]);
+                    n += p ? 1u : 0u;
+                    row[x] = p ? in : row[x];
+                }
+            } else {
+                for (int x = lo; x <= hi; ++x) n += pass_at(in, row[x]) ? 1u : 0u;
+            }
+            passed += n;
+        }
+        return passed;
+    }
     double last = std::numeric_limits<double>::quiet_NaN();  // quantize once per distinct depth
     std::uint32_t incoming = 0;
-    bounds_pixels(tri, pool, rx0, ry0, rx1, ry1, [&](int px, int py, double zlo, double zhi) {
+    bounds_pixels(tri, pool, rx0, ry0, rx1, ry1, [&](int px, int py, double zlo, double zhi) __attribute__((always_inline)) {
         const double z = write ? zlo : zhi;
         if (!(z == last)) {
             last = z;
-            incoming = write ? quantize_down(zlo - tri.margin_z, format) : quantize_up(zhi + tri.margin_z, format);
+            incoming = write ? quantize_down(zlo - mz, format) : quantize_up(zhi + mz, format);
         }
         std::uint32_t& stored = depth[static_cast<std::size_t>(py) * static_cast<std::size_t>(stride) +
                                       static_cast<std::size_t>(px)];
-        const bool pass = d32f ? depth_pass(func, std::bit_cast<float>(incoming), std::bit_cast<float>(stored))
-                               : depth_pass(func, incoming, stored);
-        if (pass) {
+        if (pass_at(incoming, stored)) {
             ++passed;
             if (write) stored = incoming;
         }
     });
     return passed;
+}
+
+template <bool D32F>
+std::uint64_t bounds_rect_format(const BoundsTri& tri, const BoundsVertex* pool, DepthFormat format, DepthFunc func,
+                                 bool write, std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1) {
+    switch (func) {
+        case DepthFunc::Never:
+            return 0;  // nothing passes, nothing is written
+        case DepthFunc::Less:
+            return bounds_rect_impl<DepthFunc::Less, D32F>(tri, pool, format, write, depth, stride, rx0, ry0, rx1, ry1);
+        case DepthFunc::Equal:
+            return bounds_rect_impl<DepthFunc::Equal, D32F>(tri, pool, format, write, depth, stride, rx0, ry0, rx1, ry1);
+        case DepthFunc::LEqual:
+            return bounds_rect_impl<DepthFunc::LEqual, D32F>(tri, pool, format, write, depth, stride, rx0, ry0, rx1, ry1);
+        case DepthFunc::Greater:
+            return bounds_rect_impl<DepthFunc::Greater, D32F>(tri, pool, format, write, depth, stride, rx0, ry0, rx1, ry1);
+        case DepthFunc::NotEqual:
+            return bounds_rect_impl<DepthFunc::NotEqual, D32F>(tri, pool, format, write, depth, stride, rx0, ry0, rx1, ry1);
+        case DepthFunc::GEqual:
+            return bounds_rect_impl<DepthFunc::GEqual, D32F>(tri, pool, format, write, depth, stride, rx0, ry0, rx1, ry1);
+        case DepthFunc::Always:
+            return bounds_rect_impl<DepthFunc::Always, D32F>(tri, pool, format, write, depth, stride, rx0, ry0, rx1, ry1);
+    }
+    return 0;
+}
+
+}  // namespace
+
+std::uint64_t bounds_rect(const BoundsTri& tri, const BoundsVertex* pool, DepthFormat format, DepthFunc func,
+                          bool write, std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1) {
+    if (format == DepthFormat::D32F)
+        return bounds_rect_format<true>(tri, pool, format, func, write, depth, stride, rx0, ry0, rx1, ry1);
+    return bounds_rect_format<false>(tri, pool, format, func, write, depth, stride, rx0, ry0, rx1, ry1);
 }
 
 }  // namespace raster::detail

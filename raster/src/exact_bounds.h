@@ -2,18 +2,23 @@
 //
 // Front end: one input triangle (double clip space, w = 1) is clipped against the clip volume grown
 // by a margin, in double, and mapped to window coordinates: a convex polygon of at most 9 vertices
-// (a segment or a point for degenerate input). Back end: per pixel, the polygon is clipped against
-// the pixel's closed square grown by a margin; if anything is left the pixel is covered, and the
-// min / max depth of what is left, widened by a margin and rounded outward to the depth format,
-// is the pixel's [zmin, zmax]. The margins exceed every rounding error of those steps
+// (a segment or a point for degenerate input). Back end: a pixel is covered when its closed square
+// grown by a margin meets the polygon, and [zmin, zmax] bounds the polygon's depth over that part,
+// widened by a margin and rounded outward to the depth format. Four traversals compute it (chosen
+// per triangle): the general one (per-row clipping and per-column edge crossings: the exact
+// polygon-square depth range), the plane path (separating-axis coverage and the plane's range over
+// the square, with computed error bounds), and the column / row paths for triangles one or two
+// pixels thin. The margins and bounds exceed every rounding error of those steps
 // (docs/reliable-raster.md, "Why every rounding is covered"), so the result contains the exact one.
 // Every pixel is computed from the polygon alone (never accumulated), so traversal order, tiling and
 // thread count cannot change a bit.
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "pipeline.h"
@@ -40,7 +45,41 @@ struct BoundsTri {
     // The box (grown by margin_xy, before clamping to the target) is one pixel: that pixel's grown
     // square holds the whole polygon, so its range is the polygon's vertex depth range.
     bool single = false;
+    // Which per-pixel path bounds_pixels takes (chosen once by setup_bounds_triangle):
+    //  General:  per-row Sutherland-Hodgman clip + per-column edge crossings (any polygon);
+    //  Plane:    separating-axis coverage + plane depth, closed form per pixel (a polygon of 3
+    //            vertices, box > 4 pixels, certain orientation, well-conditioned plane; BoundsPlane);
+    //  Column:   every vertex has the same X (an edge-on triangle seen as a vertical segment, e.g.
+    //            the sides of CULLIDE's axis-aligned boxes), or the polygon lies inside every box
+    //            column's grown interval (thin triangles one or two columns wide): per row, the
+    //            polygon's depth range over the row slab; the same for the one or two columns.
+    //  Row:      the same with X and Y exchanged.
+    enum class Kind : std::uint8_t { General, Plane, Column, Row };
+    Kind kind = Kind::General;
+    // Kind::Plane keeps its BoundsPlane in the pool right after the polygon (kPlaneSlots vertex
+    // slots), so that BoundsTri stays small for the other kinds (load_plane).
 };
+
+// Plane-path data, in coordinates local to the anchor pixel (x0, y0) (see docs/reliable-raster.md,
+// "Why every rounding is covered", 8-9): pixel (px, py) is (lx, ly) = (px - x0, py - y0), exact
+// small integers.
+struct BoundsPlane {
+    // Edge i: the pixel's grown square misses the triangle when ea * lx + (eb * ly + ek) < et.
+    double ea[3], eb[3], ek[3], et[3];
+    double inv_a[3];  // 1 / ea (0 when ea = 0): only to estimate where a row crosses the edge
+    // Depth: centre value pz + pgx * lx + pgy * ly, widened by pw, clamped to [pzlo, pzhi].
+    double pz, pgx, pgy, pw, pzlo, pzhi;
+    // Widening of a slab depth range (slab_depth_range) for its rounding (tightening only).
+    double sw;
+};
+inline constexpr int kPlaneSlots = static_cast<int>((sizeof(BoundsPlane) + sizeof(BoundsVertex) - 1) / sizeof(BoundsVertex));
+
+inline BoundsPlane load_plane(const BoundsTri& t, const BoundsVertex* pool) {
+    BoundsPlane d;
+    std::memcpy(&d, pool + t.first + static_cast<std::uint32_t>(t.n), sizeof d);
+    return d;
+}
+
 
 // Appends 0 or 1 BoundsTri for the triangle (a, b, c) to `out` and its polygon to `pool`. Inputs
 // were validated (finite, w = 1, |coordinate| <= kMaxExactBoundsCoordinate).
@@ -54,9 +93,52 @@ std::uint64_t bounds_rect(const BoundsTri& tri, const BoundsVertex* pool, DepthF
                           bool write, std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1);
 
 // Outward quantization of a window depth in [0, 1] to the stored encoding (exposed for tests):
-// down = the largest representable value <= z, up = the smallest >= z.
-std::uint32_t quantize_down(double z, DepthFormat format);
-std::uint32_t quantize_up(double z, DepthFormat format);
+// down = the largest representable value <= z, up = the smallest >= z. Inline: with the plane path
+// every pixel has its own depth, so these run per pixel.
+inline constexpr double kQuantFracGuard = 0x1p-27;  // > 2^-29, the rounding error of z * n for n < 2^24
+
+inline std::uint32_t quantize_down(double z, DepthFormat format) {
+    z = z > 0.0 ? z : 0.0;
+    z = z < 1.0 ? z : 1.0;
+    if (format == DepthFormat::D32F) {
+        float f = static_cast<float>(z);
+        if (static_cast<double>(f) > z) f = std::nextafter(f, -1.0f);
+        return std::bit_cast<std::uint32_t>(f);
+    }
+    const double n = format == DepthFormat::D16 ? 65535.0 : 16777215.0;
+    const double q = z * n;
+    // 0 <= q < 2^24: truncation is the floor (and avoids a libm call on baseline x86-64).
+    double v = static_cast<double>(static_cast<std::int64_t>(q));
+    // q errs by <= 2^-29 (half an ulp below 2^24), so unless q is that close to an integer its floor
+    // is the exact one (q - v is exact). Otherwise correct exactly: the sign of fma(z, n, -v) is
+    // the sign of z * n - v.
+    const double frac = q - v;
+    if (frac >= kQuantFracGuard && frac <= 1.0 - kQuantFracGuard) return static_cast<std::uint32_t>(v);
+    if (std::fma(z, n, -v) < 0.0) v -= 1.0;
+    if (std::fma(z, n, -(v + 1.0)) >= 0.0) v += 1.0;
+    v = std::clamp(v, 0.0, n);
+    return static_cast<std::uint32_t>(v);
+}
+
+inline std::uint32_t quantize_up(double z, DepthFormat format) {
+    z = z > 0.0 ? z : 0.0;
+    z = z < 1.0 ? z : 1.0;
+    if (format == DepthFormat::D32F) {
+        float f = static_cast<float>(z);
+        if (static_cast<double>(f) < z) f = std::nextafter(f, 2.0f);
+        return std::bit_cast<std::uint32_t>(f);
+    }
+    const double n = format == DepthFormat::D16 ? 65535.0 : 16777215.0;
+    const double q = z * n;
+    double v = static_cast<double>(static_cast<std::int64_t>(q));
+    if (v < q) v += 1.0;        // the ceiling
+    const double frac = v - q;  // exact, as above
+    if (frac >= kQuantFracGuard && frac <= 1.0 - kQuantFracGuard) return static_cast<std::uint32_t>(v);
+    if (std::fma(z, n, -v) > 0.0) v += 1.0;
+    if (std::fma(z, n, -(v - 1.0)) <= 0.0) v -= 1.0;
+    v = std::clamp(v, 0.0, n);
+    return static_cast<std::uint32_t>(v);
+}
 
 // ---- the per-pixel traversal shared by bounds_rect and the fused visibility pass ----
 
@@ -67,13 +149,96 @@ struct BoundsP3 {
 // Sutherland-Hodgman against the closed half-space s * p[axis] <= bound (exact_bounds.cpp).
 int bounds_clip_axis(const BoundsP3* in, int n, BoundsP3* out, int axis, double s, double bound);
 
+// Pixel boxes at most this wide also clamp the plane path's depth to each column slab's range.
+inline constexpr int kTightColumns = 32;
+
+// The plane path's pixels of one row (local row ly) inside the local columns [lo, hi]: narrows
+// [lo, hi] to the pixels that no edge test drops (empty: lo > hi). Each edge's computed test
+// fl(fl(ea * lx) + r) >= et is monotone in lx (rounding is monotone), so its pixels are a prefix or
+// a suffix of the row, and their intersection is an interval. Each end is estimated by a division
+// and then settled with the test itself, so the interval holds exactly the pixels that the
+// per-pixel test keeps, whatever the estimate's rounding.
+__attribute__((always_inline)) inline void plane_row_span(const BoundsPlane& d, double ly, int& lo_io,
+                                                          int& hi_io) {
+    int lo = lo_io, hi = hi_io;
+    for (int i = 0; i < 3 && lo <= hi; ++i) {
+        const double a = d.ea[i], r = d.eb[i] * ly + d.ek[i], et = d.et[i];
+        const auto keep = [&](int lx) { return !(a * static_cast<double>(lx) + r < et); };
+        if (a == 0.0) {
+            if (!keep(lo)) hi = lo - 1;
+            continue;
+        }
+        double est = (et - r) * d.inv_a[i];  // the crossing, roughly (settled below)
+        est = est > -4.0 ? est : -4.0;
+        est = est < static_cast<double>(hi) + 4.0 ? est : static_cast<double>(hi) + 4.0;
+        int k = static_cast<int>(est);
+        if (a > 0.0) {  // kept: a suffix [k, ...]
+            k = std::clamp(k, lo, hi + 1);
+            while (k > lo && keep(k - 1)) --k;
+            while (k <= hi && !keep(k)) ++k;
+            lo = k;
+        } else {  // kept: a prefix [..., k]
+            k = std::clamp(k, lo - 1, hi);
+            while (k < hi && keep(k + 1)) ++k;
+            while (k >= lo && !keep(k)) --k;
+            hi = k;
+        }
+    }
+    lo_io = lo;
+    hi_io = hi;
+}
+
+// One polygon edge prepared for slab depth ranges along t (t = Y or X): its ends, depth at p,
+// dz/dt (0 when the edge is perpendicular to t: it then never crosses a slab side strictly) and its
+// depth range. Computed once per bounds_pixels call, not per row or pixel.
+struct SlabEdge {
+    double tp, tq, zp, slope, emin, emax;
+};
+
+template <bool ByY>
+inline void slab_edges(const BoundsVertex* v, int n, SlabEdge* e) {
+    for (int i = 0; i < n; ++i) {
+        const BoundsVertex& p = v[i];
+        const BoundsVertex& q = v[i + 1 == n ? 0 : i + 1];
+        const double tp = ByY ? p.y : p.x, tq = ByY ? q.y : q.x;
+        e[i] = {tp, tq, p.z, tq != tp ? (q.z - p.z) / (tq - tp) : 0.0, std::min(p.z, q.z), std::max(p.z, q.z)};
+    }
+}
+
+// The depth range over the slab lo <= t <= hi of the polygon (edges e[0..n)) taken in (t, z): the
+// vertices inside the slab and the edges' crossings of its two sides (a linear function's extremes
+// over a convex set lie on its boundary); crossings are interpolated along the edge and clamped to
+// its depth range. Empty (zlo > zhi) when nothing of the polygon is inside.
+inline void slab_depth_range(const SlabEdge* e, int n, double lo, double hi, double& zlo, double& zhi) {
+    zlo = __builtin_inf();
+    zhi = -__builtin_inf();
+    for (int i = 0; i < n; ++i) {
+        const SlabEdge& g = e[i];
+        if (g.tp >= lo && g.tp <= hi) {
+            zlo = std::min(zlo, g.zp);
+            zhi = std::max(zhi, g.zp);
+        }
+        if ((g.tp < lo && g.tq > lo) || (g.tp > lo && g.tq < lo)) {
+            const double z = std::clamp(g.zp + (lo - g.tp) * g.slope, g.emin, g.emax);
+            zlo = std::min(zlo, z);
+            zhi = std::max(zhi, z);
+        }
+        if ((g.tp < hi && g.tq > hi) || (g.tp > hi && g.tq < hi)) {
+            const double z = std::clamp(g.zp + (hi - g.tp) * g.slope, g.emin, g.emax);
+            zlo = std::min(zlo, z);
+            zhi = std::max(zhi, z);
+        }
+    }
+}
+
 // Calls f(px, py, zlo, zhi) for every pixel of [rx0, rx1] x [ry0, ry1] whose square (grown by
-// tri.margin_xy) meets the polygon, with the polygon's exact-arithmetic-rounded depth range over
-// that part (before margin_z and quantization): see docs/reliable-raster.md. Rows in increasing
-// order, pixels of a row in increasing order. The values do not depend on the rectangle: a pixel
-// gets the same (zlo, zhi) whichever rectangle (tile) contains it.
+// tri.margin_xy) meets the polygon (the plane path may add pixels that a rounding-error bound
+// cannot rule out), with a range containing the polygon's depths over that part (before margin_z
+// and quantization): see docs/reliable-raster.md. Rows in increasing order, pixels of a row in
+// increasing order. The values do not depend on the rectangle: a pixel gets the same (zlo, zhi)
+// whichever rectangle (tile) contains it.
 //
-// Per row: the polygon is clipped to the row's slab (skipped when it already lies inside it: the
+// General path, per row: the polygon is clipped to the row's slab (skipped when it already lies inside it: the
 // clip would return it unchanged); then the depth range over each pixel's column is the range
 // over the row polygon's boundary inside the column (a linear function's extremes over a convex
 // set lie on its boundary): its vertices inside the column and its edges' crossings of the
@@ -96,7 +261,107 @@ inline void bounds_pixels(const BoundsTri& tri, const BoundsVertex* pool, int rx
         f(tri.x0, tri.y0, zlo, zhi);
         return;
     }
+    if (tri.kind == BoundsTri::Kind::Plane) {
+        // Separating axes (the idea of conservative rasterization on GPUs: Hasselgren, Akenine-Moller
+        // and Ohlsson, GPU Gems 2 ch. 42): a convex triangle and a square are disjoint iff one of the
+        // square's two axes or the triangle's three edge normals separates them. The pixel box
+        // already handles the square's axes; per edge, the grown square is dropped only when the
+        // edge function, at the square's corner that maximizes it, is below a threshold that covers
+        // every rounding (setup). Depth: the plane over the grown square, widened by its error
+        // bound and clamped to the vertex depth range. Closed form per pixel, nothing carried from
+        // pixel to pixel: a pixel gets the same values in any rectangle (tile).
+        //
+        // Tightening (not needed for correctness): the plane's range over the whole square is loose
+        // where the square sticks out of the triangle (most pixels of a sliver), so it is also
+        // clamped to the triangle's depth range over the pixel's row slab and, for boxes at most
+        // kTightColumns wide, over its column slab (each read off the boundary, slab_depth_range,
+        // widened by sw for its rounding). Each range is a function of py or px alone.
+        const BoundsPlane d = load_plane(tri, pool);
+        const int ys = std::max(ry0, tri.y0), ye = std::min(ry1, tri.y1);
+        const int xs = std::max(rx0, tri.x0), xe = std::min(rx1, tri.x1);
+        if (xs > xe || ys > ye) return;
+        const double m = tri.margin_xy;
+        const BoundsVertex* v = pool + tri.first;
+        const bool tight = d.pzlo != d.pzhi;  // constant depth: [z, z] already
+        const bool tight_cols = tight && tri.x1 - tri.x0 < kTightColumns;
+        double col_lo[kTightColumns], col_hi[kTightColumns];
+        SlabEdge ex[3], ey[3];
+        if (tight) slab_edges<true>(v, 3, ey);
+        if (tight_cols) {
+            slab_edges<false>(v, 3, ex);
+            for (int px = xs; px <= xe; ++px) {
+                const double fx = static_cast<double>(px);
+                double a = 0, b = 0;
+                slab_depth_range(ex, 3, fx - m, fx + 1.0 + m, a, b);
+                col_lo[px - xs] = a - d.sw;
+                col_hi[px - xs] = b + d.sw;
+            }
+        }
+        for (int py = ys; py <= ye; ++py) {
+            const double ly = static_cast<double>(py - tri.y0);
+            const double rz = d.pz + d.pgy * ly;
+            int lo = xs - tri.x0, hi = xe - tri.x0;  // local pixel columns
+            plane_row_span(d, ly, lo, hi);
+            if (lo > hi) continue;
+            double rlo = d.pzlo, rhi = d.pzhi;
+            if (tight) {
+                const double fy = static_cast<double>(py);
+                double a = 0, b = 0;
+                slab_depth_range(ey, 3, fy - m, fy + 1.0 + m, a, b);
+                rlo = std::max(rlo, a - d.sw);
+                rhi = std::min(rhi, b + d.sw);
+            }
+            for (int px = tri.x0 + lo; px <= tri.x0 + hi; ++px) {
+                const double lx = static_cast<double>(px - tri.x0);
+                const double zc = rz + d.pgx * lx;
+                const double zl = zc - d.pw, zh = zc + d.pw;
+                double zlo = zl > rlo ? zl : rlo;
+                double zhi = zh < rhi ? zh : rhi;
+                if (tight_cols) {
+                    zlo = std::max(zlo, col_lo[px - xs]);
+                    zhi = std::min(zhi, col_hi[px - xs]);
+                }
+                // An empty interval proves that the square misses the triangle (a point of it
+                // would have its depth in every range): nothing to report.
+                if (zlo <= zhi) f(px, py, zlo, zhi);
+            }
+        }
+        return;
+    }
     const double m = tri.margin_xy;
+    if (tri.kind == BoundsTri::Kind::Column || tri.kind == BoundsTri::Kind::Row) {
+        // Column: every column of the box contains the polygon's X range in its grown interval
+        // (or every vertex has the same X), so the polygon's part above pixel (px, py)'s grown
+        // square is its part over the row slab [py - m, py + 1 + m], whatever px: its depth range
+        // is read off its boundary (slab_depth_range: the general path's column code with Y for X,
+        // without clipping) once per row and reported for the box's columns (one or two). Row: the
+        // same with X and Y exchanged.
+        const int ys = std::max(ry0, tri.y0), ye = std::min(ry1, tri.y1);
+        const int xs = std::max(rx0, tri.x0), xe = std::min(rx1, tri.x1);
+        if (xs > xe || ys > ye) return;
+        const BoundsVertex* v = pool + tri.first;
+        double zlo = 0, zhi = 0;
+        SlabEdge e[kBoundsMaxVerts];
+        if (tri.kind == BoundsTri::Kind::Column) {
+            slab_edges<true>(v, tri.n, e);
+            for (int py = ys; py <= ye; ++py) {
+                const double fy = static_cast<double>(py);
+                slab_depth_range(e, tri.n, fy - m, fy + 1.0 + m, zlo, zhi);
+                if (!(zlo <= zhi)) continue;
+                for (int px = xs; px <= xe; ++px) f(px, py, zlo, zhi);
+            }
+        } else {
+            slab_edges<false>(v, tri.n, e);
+            for (int py = ys; py <= ye; ++py) {  // one or two rows: recomputed per row, in order
+                for (int px = xs; px <= xe; ++px) {
+                    const double fx = static_cast<double>(px);
+                    slab_depth_range(e, tri.n, fx - m, fx + 1.0 + m, zlo, zhi);
+                    if (zlo <= zhi) f(px, py, zlo, zhi);
+                }
+            }
+        }
+        return;
+    }
     BoundsP3 poly[kBoundsMaxVerts];
     double py_lo = 1e308, py_hi = -1e308;
     for (int i = 0; i < tri.n; ++i) {

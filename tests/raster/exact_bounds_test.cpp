@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "exact_bounds.h"  // white box: which per-pixel path a triangle takes (raster/src)
 #include "exact_bounds_reference.h"
 #include "raster/raster.h"
 #include "test_rng.h"
@@ -369,4 +370,299 @@ TEST_CASE("Exact-bounds writes round outward: a flat triangle's stored depth bra
             }
         }
     }
+}
+
+namespace {
+
+// One triangle through the exact-bounds write (ALWAYS, mask on) and a GEQUAL probe, against the
+// exact reference: every exactly covered pixel holds a written value <= the exact zmin, the probe
+// passes on exactly the exactly covered pixels (so zmax >= exact zmax and coverage is complete),
+// and nothing is covered beyond the exact pixel box grown by one pixel (only when every |coordinate|
+// is at most 2^20: the clip margin grows with the magnitude M, 2^-40 M, so huge inputs are looser
+// by design). Returns the covered count.
+int check_against_exact(const Tri& t, int w, int h, DepthFormat f) {
+    bool moderate = true;
+    for (const auto& v : t.v) moderate = moderate && std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}) <= 0x1p20;
+    const std::vector<std::uint32_t> idx = {0, 1, 2};
+    const raster::MeshViewD mesh{t.v, idx};
+    const raster_ref::ExactTriangle exact(raster::Viewport{0, 0, w, h}, t.v[0], t.v[1], t.v[2]);
+    auto target = raster::DepthTarget::create(w, h, f);
+    REQUIRE(target.ok());
+    raster::CommandBatch write(w, h);
+    raster::DrawState ws;
+    ws.mode = raster::RasterMode::ExactBounds;
+    ws.depth_func = raster::DepthFunc::Always;
+    write.draw(mesh, ws);
+    REQUIRE(raster::execute(target.value(), write, raster::ExecuteOptions{2}).ok());
+    const std::uint32_t clear = raster::DepthTarget::encode_clear(1.0, f);
+    auto probe = raster::DepthTarget::create(w, h, f);
+    REQUIRE(probe.ok());
+    const auto pv = probe.value().mutable_values();
+    int covered = 0;
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            CAPTURE(x);
+            CAPTURE(y);
+            const raster_ref::PixelRange r = exact.pixel(x, y);
+            const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+            const std::uint32_t written = target.value().value(x, y);
+            if (!r.covered) {
+                pv[i] = impossible_high(f);
+                if (moderate && written != clear) {  // tight: within one pixel of the exact box
+                    REQUIRE(!exact.empty());
+                    CHECK(x >= exact.x0 - 1);
+                    CHECK(x <= exact.x1 + 1);
+                    CHECK(y >= exact.y0 - 1);
+                    CHECK(y <= exact.y1 + 1);
+                }
+                continue;
+            }
+            ++covered;
+            pv[i] = raster_ref::floor_value(r.zmax, f);
+            CHECK(raster_ref::stored_depth(written, f) <= r.zmin);
+        }
+    }
+    raster::CommandBatch query(w, h);
+    raster::DrawState qs;
+    qs.mode = raster::RasterMode::ExactBounds;
+    qs.depth_func = raster::DepthFunc::GEqual;
+    qs.depth_write = false;
+    query.begin_query(raster::QueryKind::SamplesPassed);
+    query.draw(mesh, qs);
+    query.end_query();
+    auto got = raster::execute(probe.value(), query, raster::ExecuteOptions{3});
+    REQUIRE(got.ok());
+    CHECK(got.value()[0] == static_cast<std::uint64_t>(covered));
+    return covered;
+}
+
+// The per-pixel path the exact-bounds setup picks for a triangle (General when it is one pixel or
+// culled: those never reach the new paths).
+raster::detail::BoundsTri::Kind path_of(const Tri& t, int w, int h) {
+    raster::detail::FrontEndParams p{};
+    p.target_width = w;
+    p.target_height = h;
+    p.viewport = raster::Viewport{0, 0, w, h};
+    p.cull_face = raster::CullFace::None;
+    p.front_face = raster::FrontFace::CCW;
+    std::vector<raster::detail::BoundsTri> out;
+    std::vector<raster::detail::BoundsVertex> pool;
+    raster::detail::setup_bounds_triangle(p, t.v[0], t.v[1], t.v[2], 0, out, pool);
+    if (out.empty() || out[0].single) return raster::detail::BoundsTri::Kind::General;
+    return out[0].kind;
+}
+
+// Triangles aimed at the plane (separating-axis) path, the edge-on row / column paths and their
+// fallbacks, in clip space for a w x h viewport.
+Tri targeted_triangle(test::Rng& rng, int kind, int w, int h) {
+    const double px = 2.0 / w, py = 2.0 / h;  // one pixel in clip units
+    auto z = [&] { return rng.uniform(-1.0, 1.0); };
+    auto on_lattice = [&](double pixel, int n) {  // pixel corners and centres
+        return -1.0 + pixel * 0.5 * static_cast<double>(rng.below(static_cast<std::uint64_t>(2 * n + 1)));
+    };
+    Tri t;
+    switch (kind) {
+        case 0: {  // sliver: a long edge and a third vertex 2^-k of its length off it
+            const double x0 = rng.uniform(-1.1, 1.1), y0 = rng.uniform(-1.1, 1.1);
+            const double ang = rng.uniform(0.0, 6.283185307179586);
+            const double len = rng.uniform(0.2, 1.5);
+            const double dx = std::cos(ang) * len, dy = std::sin(ang) * len;
+            const double s = rng.uniform(0.05, 0.95), off = std::ldexp(rng.sym(), -static_cast<int>(rng.range(3, 30)));
+            t.v[0] = {x0, y0, z(), 1};
+            t.v[1] = {x0 + dx, y0 + dy, z(), 1};
+            t.v[2] = {x0 + s * dx - off * dy, y0 + s * dy + off * dx, z(), 1};
+            break;
+        }
+        case 1: {  // nearly collinear: orientation uncertain after rounding (offsets 2^-30 .. 2^-62)
+            const double x0 = rng.uniform(-1, 1), y0 = rng.uniform(-1, 1);
+            const double x1 = rng.uniform(-1, 1), y1 = rng.uniform(-1, 1);
+            const double s = rng.unit(), off = std::ldexp(rng.sym(), -static_cast<int>(rng.range(30, 62)));
+            t.v[0] = {x0, y0, z(), 1};
+            t.v[1] = {x1, y1, z(), 1};
+            t.v[2] = {x0 + s * (x1 - x0) - off * (y1 - y0), y0 + s * (y1 - y0) + off * (x1 - x0), z(), 1};
+            break;
+        }
+        case 2: {  // axis-aligned edge-on: one common x (or y), often on a pixel boundary
+            const bool by_x = rng.coin();
+            const double c = rng.coin() ? on_lattice(by_x ? px : py, by_x ? w : h) : rng.uniform(-1.05, 1.05);
+            for (auto& v : t.v) {
+                const double o = rng.uniform(-1.2, 1.2);
+                v = by_x ? Double4{c, o, z(), 1} : Double4{o, c, z(), 1};
+            }
+            break;
+        }
+        case 3: {  // oblique edge-on: three points of one line (up to the rounding of their coordinates)
+            const double x0 = rng.uniform(-1, 1), y0 = rng.uniform(-1, 1);
+            const double dx = rng.sym(), dy = rng.sym();
+            for (auto& v : t.v) {
+                const double s = rng.uniform(-0.7, 0.7);
+                v = {x0 + s * dx, y0 + s * dy, z(), 1};
+            }
+            break;
+        }
+        case 4: {  // vertices on pixel corners and centres: edges along pixel boundaries
+            for (auto& v : t.v) v = {on_lattice(px, w), on_lattice(py, h), rng.coin() ? 0.25 : z(), 1};
+            break;
+        }
+        case 5: {  // steep: depth jumps across a pixel or less
+            const double x0 = rng.uniform(-1, 1), y0 = rng.uniform(-1, 1);
+            t.v[0] = {x0, y0, -1, 1};
+            t.v[1] = {x0 + rng.uniform(-1.5, 1.5) * px, y0 + rng.uniform(-1.5, 1.5) * py, 1, 1};
+            t.v[2] = {x0 + rng.uniform(-8, 8) * px, y0 + rng.uniform(-8, 8) * py, z(), 1};
+            break;
+        }
+        case 6: {  // huge coordinates (clipped), tiny triangles (1e-12 of the view), beyond the depth range
+            const int sub = static_cast<int>(rng.below(3));
+            const double x0 = rng.uniform(-1, 1), y0 = rng.uniform(-1, 1);
+            for (auto& v : t.v) {
+                if (sub == 0)
+                    v = {rng.sym() * std::ldexp(1.0, rng.range(10, 90)), rng.sym() * std::ldexp(1.0, rng.range(10, 90)),
+                         rng.uniform(-3, 3), 1};
+                else if (sub == 1)
+                    v = {x0 + rng.sym() * 1e-12, y0 + rng.sym() * 1e-12, z(), 1};
+                else
+                    v = {rng.uniform(-1.5, 1.5), rng.uniform(-1.5, 1.5), rng.uniform(-4, 4), 1};
+            }
+            break;
+        }
+        default: {  // constant depth, anywhere (screen-parallel faces)
+            const double zc = z();
+            for (auto& v : t.v) v = {rng.uniform(-1.2, 1.2), rng.uniform(-1.2, 1.2), zc, 1};
+            break;
+        }
+    }
+    return t;
+}
+
+}  // namespace
+
+TEST_CASE("Exact-bounds fast paths (plane, edge-on rows and columns, fallbacks) contain the exact result") {
+    // Slivers, nearly degenerate triangles of uncertain orientation, axis-aligned and oblique
+    // edge-on triangles, lattice-aligned edges, steep planes, huge / tiny coordinates, clipped
+    // triangles and constant depth: every check of check_against_exact, on the path each takes.
+    test::Rng rng(777);
+    const int sizes[][2] = {{24, 24}, {17, 31}, {40, 9}};
+    int covered_total = 0;
+    int paths[4] = {0, 0, 0, 0};
+    for (int rep = 0; rep < 400; ++rep) {
+        const int kind = rep % 8;
+        const DepthFormat f = kFormats[(rep / 8) % 3];
+        const int w = sizes[(rep / 3) % 3][0], h = sizes[(rep / 3) % 3][1];
+        const Tri t = targeted_triangle(rng, kind, w, h);
+        CAPTURE(rep);
+        CAPTURE(kind);
+        CAPTURE(static_cast<int>(f));
+        ++paths[static_cast<int>(path_of(t, w, h))];
+        covered_total += check_against_exact(t, w, h, f);
+    }
+    CHECK(covered_total > 2000);
+    // Every path is exercised (General includes the fallbacks of slivers and uncertain orientations).
+    CHECK(paths[static_cast<int>(raster::detail::BoundsTri::Kind::General)] > 20);
+    CHECK(paths[static_cast<int>(raster::detail::BoundsTri::Kind::Plane)] > 100);
+    CHECK(paths[static_cast<int>(raster::detail::BoundsTri::Kind::Column)] > 10);
+    CHECK(paths[static_cast<int>(raster::detail::BoundsTri::Kind::Row)] > 10);
+}
+
+TEST_CASE("Exact-bounds path choice: well-shaped triangles take the plane path, degenerate ones do not") {
+    const int w = 32, h = 32;
+    // A plain triangle several pixels wide.
+    CHECK(path_of(Tri{{{-0.5, -0.5, 0.1, 1}, {0.5, -0.4, 0.3, 1}, {0.0, 0.6, -0.2, 1}}}, w, h) ==
+          raster::detail::BoundsTri::Kind::Plane);
+    // Edge-on along x and along y.
+    CHECK(path_of(Tri{{{0.25, -0.5, 0.1, 1}, {0.25, 0.5, 0.3, 1}, {0.25, 0.0, -0.9, 1}}}, w, h) ==
+          raster::detail::BoundsTri::Kind::Column);
+    CHECK(path_of(Tri{{{-0.5, 0.25, 0.1, 1}, {0.5, 0.25, 0.3, 1}, {0.0, 0.25, -0.9, 1}}}, w, h) ==
+          raster::detail::BoundsTri::Kind::Row);
+    // Collinear up to 2^-60 (orientation not certain; zero area after rounding): the general path.
+    CHECK(path_of(Tri{{{-0.5, -0.5, 0.1, 1}, {0.5, 0.5, 0.3, 1}, {0.0, 0x1p-60, -0.9, 1}}}, w, h) ==
+          raster::detail::BoundsTri::Kind::General);
+    // Crossing the clip volume (a clipped polygon): the general path.
+    CHECK(path_of(Tri{{{-0.5, -0.5, 0.1, 1}, {3.0, -0.4, 0.3, 1}, {0.0, 0.6, -0.2, 1}}}, w, h) ==
+          raster::detail::BoundsTri::Kind::General);
+}
+
+TEST_CASE("Exact-bounds plane path: the written depth of an interior pixel is within the documented bound") {
+    // Tightness of the plane path (docs/reliable-raster.md, "The plane path"): for a pixel whose
+    // square lies inside the triangle, the written zmin is below the exact minimum over the pixel by
+    // at most g * m + 2^-36 + margin_z before the outward rounding, with g = |gx| + |gy| (which is
+    // the exact range over a full square) and m = margin_xy ~ 2^-20: the same slack as the general
+    // path's grown slabs. Checked as: written >= floor(exact zmin - g 2^-18 - 2^-30) less one step.
+    test::Rng rng(4711);
+    int interior = 0;
+    for (int rep = 0; rep < 60; ++rep) {
+        const DepthFormat f = kFormats[rep % 3];
+        const int w = 24, h = 24;
+        const Tri t{{{rng.uniform(-1, -0.5), rng.uniform(-1, -0.5), rng.uniform(-0.9, 0.9), 1},
+                     {rng.uniform(0.5, 1), rng.uniform(-1, 0), rng.uniform(-0.9, 0.9), 1},
+                     {rng.uniform(-0.5, 0.5), rng.uniform(0.5, 1), rng.uniform(-0.9, 0.9), 1}}};
+        CAPTURE(rep);
+        REQUIRE(path_of(t, w, h) == raster::detail::BoundsTri::Kind::Plane);
+        const std::vector<std::uint32_t> idx = {0, 1, 2};
+        auto target = raster::DepthTarget::create(w, h, f);
+        REQUIRE(target.ok());
+        raster::CommandBatch b(w, h);
+        raster::DrawState s;
+        s.mode = raster::RasterMode::ExactBounds;
+        s.depth_func = raster::DepthFunc::Always;
+        b.draw(raster::MeshViewD{t.v, idx}, s);
+        REQUIRE(raster::execute(target.value(), b).ok());
+        const raster_ref::ExactTriangle exact(raster::Viewport{0, 0, w, h}, t.v[0], t.v[1], t.v[2]);
+        // Exact window vertices (viewport at the origin: X = x w/2 + w/2) and the sign of the area.
+        mpq_class X[3], Y[3];
+        for (int k = 0; k < 3; ++k) {
+            X[k] = mpq_class(t.v[k].x) * w / 2 + mpq_class(w, 2);
+            Y[k] = mpq_class(t.v[k].y) * h / 2 + mpq_class(h, 2);
+        }
+        const auto orient = [&](int i, int j, const mpq_class& x, const mpq_class& y) {
+            const mpq_class v = (X[j] - X[i]) * (y - Y[i]) - (Y[j] - Y[i]) * (x - X[i]);
+            return sgn(v);
+        };
+        const int area = orient(0, 1, X[2], Y[2]);
+        REQUIRE(area != 0);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                bool inside = true;  // all four corners of the pixel square inside the triangle
+                for (int c = 0; c < 4 && inside; ++c) {
+                    const mpq_class cx(x + (c & 1)), cy(y + (c >> 1));
+                    for (int i = 0; i < 3 && inside; ++i) inside = orient(i, (i + 1) % 3, cx, cy) * area >= 0;
+                }
+                if (!inside) continue;
+                const raster_ref::PixelRange r = exact.pixel(x, y);
+                REQUIRE(r.covered);
+                ++interior;
+                CAPTURE(x);
+                CAPTURE(y);
+                const std::uint32_t written = target.value().value(x, y);
+                CHECK(raster_ref::stored_depth(written, f) <= r.zmin);
+                const mpq_class slack = (r.zmax - r.zmin) / (1 << 18) + mpq_class(1, 1u << 30);
+                const mpq_class lowest = r.zmin - slack < 0 ? mpq_class(0) : mpq_class(r.zmin - slack);
+                const std::uint32_t fl = raster_ref::floor_value(lowest, f);
+                if (f == DepthFormat::D32F) {
+                    const float sf = std::bit_cast<float>(written), ff = std::bit_cast<float>(fl);
+                    CHECK((sf >= ff || std::nextafter(sf, 2.0f) >= ff));
+                } else {
+                    CHECK(written + 1 >= fl);
+                }
+            }
+    }
+    CHECK(interior > 1000);
+}
+
+TEST_CASE("Exact-bounds: triangles clipped to three vertices with huge coordinates (large margins)") {
+    // Two vertices far beyond the far plane (|z| up to 2^90) and one inside: the clip leaves a
+    // triangle, but the margins grow with the magnitude M (2^-40 M clip units), so the plane path's
+    // error bounds must cover squares grown by a large margin (or refuse the path).
+    test::Rng rng(99991);
+    int covered = 0;
+    for (int rep = 0; rep < 60; ++rep) {
+        const int e = 20 + static_cast<int>(rng.below(71));  // 2^20 .. 2^90
+        const double far = std::ldexp(1.0, e) * (rng.coin() ? 1.0 : -1.0);
+        const Tri t{{{rng.uniform(-0.8, 0.8), rng.uniform(-0.8, 0.8), rng.uniform(-0.5, 0.5), 1},
+                     {rng.uniform(-0.8, 0.8), rng.uniform(-0.8, 0.8), far, 1},
+                     {rng.uniform(-0.8, 0.8), rng.uniform(-0.8, 0.8), far * rng.uniform(0.5, 1.0), 1}}};
+        CAPTURE(rep);
+        CAPTURE(e);
+        covered += check_against_exact(t, 24, 20, kFormats[rep % 3]);
+    }
+    CHECK(covered >= 50);  // the clipped part is a small triangle around the inside vertex
 }
