@@ -476,7 +476,10 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
     if (Status s = check_inputs(objects, active, options); !s) return s.error();
     CullideStats st;
     st.objects_in = active.size();
-    raster::VisibilityPass fused;  // reused by every view of the frame
+    // Reused by every view of the frame and, per calling thread, by later frames: its buffers then
+    // stop growing after the first frame (no fresh pages to fault in per frame). It keeps no answer
+    // from one call to the next, so results cannot depend on what ran before.
+    thread_local raster::VisibilityPass fused;
 
     // Stage 1: object boxes.
     auto t0 = Clock::now();
