@@ -6,6 +6,8 @@
 #include <GL/osmesa.h>
 
 #include <cstring>
+#include <map>
+#include <utility>
 
 namespace cullide_oracle {
 
@@ -139,17 +141,22 @@ raster::Result<raster::QueryResults> OsmesaDevice::run(const raster::CommandBatc
     Impl& g = *impl_;
     OSMesaMakeCurrent(g.ctx, g.window.data(), GL_UNSIGNED_BYTE, 4, 4);
     glBindFramebuffer(GL_FRAMEBUFFER, g.fbo);
-    // One vertex and one index buffer for the whole batch; each draw uses a base vertex.
+    // One vertex and one index buffer for the whole batch; each draw uses a base vertex. Draws over
+    // the same vertex span (CULLIDE's sub-object draws all index their object's vertices) share one
+    // copy: copying the span per draw made batches of a large object gigabytes (GL_OUT_OF_MEMORY).
     std::vector<raster::Float4> verts;
     std::vector<std::uint32_t> idx;
     struct Range {
         std::size_t first_index, count, base_vertex;
     };
     std::vector<Range> ranges;
+    std::map<std::pair<const raster::Float4*, std::size_t>, std::size_t> span_base;
     for (const auto& c : batch.commands()) {
         if (c.kind != raster::Command::Kind::Draw) continue;
-        ranges.push_back({idx.size(), c.mesh.indices.size(), verts.size()});
-        verts.insert(verts.end(), c.mesh.vertices.begin(), c.mesh.vertices.end());
+        const auto key = std::make_pair(c.mesh.vertices.data(), c.mesh.vertices.size());
+        auto [it, fresh] = span_base.try_emplace(key, verts.size());
+        if (fresh) verts.insert(verts.end(), c.mesh.vertices.begin(), c.mesh.vertices.end());
+        ranges.push_back({idx.size(), c.mesh.indices.size(), it->second});
         idx.insert(idx.end(), c.mesh.indices.begin(), c.mesh.indices.end());
     }
     glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(verts.size() * sizeof(raster::Float4)), verts.data(),
