@@ -75,6 +75,9 @@ if [ $skip_build -eq 0 ]; then
   if grep -q "peers_bench" "$build/build.ninja" 2>/dev/null; then
     step build-peers cmake --build "$build" --target peers_bench -j"$(nproc)"
   fi
+  if [ "$mode" = full ] && grep -q "pipeline_bench" "$build/build.ninja" 2>/dev/null; then
+    step build-pipeline cmake --build "$build" --target pipeline_bench -j"$(nproc)"
+  fi
 fi
 cli=$(find "$build" -name cullide -type f -perm -u+x | head -n1)
 peers=$(find "$build" -name peers_bench -type f -perm -u+x | head -n1)
@@ -170,6 +173,13 @@ if [ -n "$peers" ]; then
   concat "$data/peers.csv" "${parts[@]}"
 else
   note "results.sh: peers_bench not built (Google Benchmark missing?): no peers table"
+fi
+
+# 4b. (--full) the same passes on OSMesa llvmpipe against the emulator (docs/results.md).
+pipeline=$(find "$build" -name pipeline_bench -type f -perm -u+x | head -n1)
+if [ "$mode" = full ] && [ -n "$pipeline" ]; then
+  step pipeline "$pipeline" --scale=0.1,cylinders=1,leaves=1,cloth=1 --frames=2 --reps=2 \
+    --benchmark_out="$data/pipeline_bench.json" --benchmark_out_format=json
 fi
 
 # 5. the two-bunnies figure: cullide at a low resolution against rcullide.
