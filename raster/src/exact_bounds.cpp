@@ -9,40 +9,6 @@
 #include <limits>
 
 namespace raster::detail {
-namespace {
-
-// Sutherland-Hodgman against the closed half-space s * p[axis] <= bound (s = +1 or -1): keeps the
-// points with d = bound - s * p[axis] >= 0. A point or a segment (degenerate input) goes through the
-// same loop and stays a point or a segment. New points lie on the edge between the two points they
-// came from (0 <= t <= 1 in floating point too), so their depth never leaves the edge's range.
-//
-// A convex polygon gains at most one vertex per plane (<= 13 in all), but rounding can make a
-// computed polygon very slightly non-convex; should the output ever not fit kBoundsMaxVerts, the
-// input is returned unclipped: a superset, so still conservative (the margins are sized from the
-// input magnitude, so they hold for unclipped coordinates too).
-}  // namespace
-
-int bounds_clip_axis(const BoundsP3* in, int n, BoundsP3* out, int axis, double s, double bound) {
-    int m = 0;
-    for (int i = 0; i < n; ++i) {
-        const BoundsP3& cur = in[i];
-        const BoundsP3& nxt = in[i + 1 == n ? 0 : i + 1];
-        const double dc = bound - s * cur.v[axis];
-        const double dn = bound - s * nxt.v[axis];
-        if (m + 2 > kBoundsMaxVerts) {
-            std::copy(in, in + n, out);
-            return n;
-        }
-        if (dc >= 0.0) out[m++] = cur;
-        if ((dc >= 0.0) != (dn >= 0.0)) {
-            const double t = dc / (dc - dn);
-            BoundsP3 p{};
-            for (int k = 0; k < 3; ++k) p.v[k] = cur.v[k] + t * (nxt.v[k] - cur.v[k]);
-            out[m++] = p;
-        }
-    }
-    return m;
-}
 
 namespace {
 
@@ -87,20 +53,15 @@ constexpr double kPlaneMaxDepthErr = pow2m(36); // depth widening beyond the squ
 
 // Chooses the per-pixel path of a (non-single) polygon `win` of n vertices with pixel box
 // [t.x0, t.x1] x [t.y0, t.y1]; fills t.kind and, for the plane path, `plane`.
-void classify_bounds_triangle(BoundsTri& t, const BoundsVertex* win, int n, BoundsPlane& plane) {
+// (minx .. maxy: the polygon's coordinate ranges, as setup_bounds_triangle computed them.)
+void classify_bounds_triangle(BoundsTri& t, const BoundsVertex* win, int n, double minx, double maxx, double miny,
+                              double maxy, BoundsPlane& plane) {
     // Column path: every vertex has the same X, or every column of the pixel box holds the whole
     // polygon's X range in its grown interval [px - m, px + 1 + m] (thin triangles one or two
     // columns wide). Then the part of the polygon above a pixel's grown square is its part over the
     // row slab, whose depth range the column path reads off the boundary. Row path: the same with
     // X and Y exchanged. (The bounds are computed as bounds_pixels computes them.)
     const double m = t.margin_xy;
-    double minx = win[0].x, maxx = minx, miny = win[0].y, maxy = miny;
-    for (int i = 1; i < n; ++i) {
-        minx = std::min(minx, win[i].x);
-        maxx = std::max(maxx, win[i].x);
-        miny = std::min(miny, win[i].y);
-        maxy = std::max(maxy, win[i].y);
-    }
     if (minx == maxx ||
         (static_cast<double>(t.x1) - m <= minx && maxx <= static_cast<double>(t.x0) + 1.0 + m)) {
         t.kind = BoundsTri::Kind::Column;
@@ -198,9 +159,11 @@ void classify_bounds_triangle(BoundsTri& t, const BoundsVertex* win, int n, Boun
 void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const Double4& b, const Double4& c,
                            std::uint32_t draw, std::vector<BoundsTri>& out, std::vector<BoundsVertex>& pool) {
     // M: the magnitude that scales every clip-space rounding error of this triangle.
-    double mag = 1.0;
-    for (const Double4* v : {&a, &b, &c})
-        mag = std::max({mag, std::fabs(v->x), std::fabs(v->y), std::fabs(v->z)});
+    // (Straight-line code for the three vertices: the same maxima and minima as loops, which the
+    // compiler does not unroll; no value is NaN, and the sign of a zero does not reach any result.)
+    const double mag = std::max(std::max(std::max(std::max(1.0, std::fabs(a.x)), std::max(std::fabs(a.y), std::fabs(a.z))),
+                                         std::max(std::max(std::fabs(b.x), std::fabs(b.y)), std::fabs(b.z))),
+                                std::max(std::max(std::fabs(c.x), std::fabs(c.y)), std::fabs(c.z)));
     const double mc = mag * kClipMarginRel;
     const double lim = 1.0 + mc;
 
@@ -218,12 +181,8 @@ void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const
     // |coordinate|, so only lim's rounding could matter, and the test is the clip's own d >= 0).
     // (lim - v >= 0 iff v <= lim and lim + v >= 0 iff v >= -lim: the signs of the rounded
     // differences are the exact ones.)
-    double cmax = cur[0].v[0], cmin = cmax;
-    for (int i = 0; i < 3; ++i)
-        for (int axis = 0; axis < 3; ++axis) {
-            cmax = cur[i].v[axis] > cmax ? cur[i].v[axis] : cmax;
-            cmin = cur[i].v[axis] < cmin ? cur[i].v[axis] : cmin;
-        }
+    const double cmax = std::max(std::max(std::max(std::max(a.x, a.y), std::max(a.z, b.x)), std::max(std::max(b.y, b.z), std::max(c.x, c.y))), c.z);
+    const double cmin = std::min(std::min(std::min(std::min(a.x, a.y), std::min(a.z, b.x)), std::min(std::min(b.y, b.z), std::min(c.x, c.y))), c.z);
     const bool inside = cmax <= lim && cmin >= -lim;
     for (int axis = 0; axis < 3 && n > 0 && !inside; ++axis) {
         for (double s : {1.0, -1.0}) {
@@ -244,12 +203,22 @@ void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const
     t.n = n;
     BoundsVertex win[kBoundsMaxVerts];
     double minx = std::numeric_limits<double>::infinity(), maxx = -minx, miny = minx, maxy = -minx;
-    for (int i = 0; i < n; ++i) {
-        win[i] = {cur[i].v[0] * hw + tx, cur[i].v[1] * hh + ty, cur[i].v[2] * 0.5 + 0.5};
-        minx = std::min(minx, win[i].x);
-        maxx = std::max(maxx, win[i].x);
-        miny = std::min(miny, win[i].y);
-        maxy = std::max(maxy, win[i].y);
+    if (inside) {  // the input triangle: the same arithmetic, unrolled
+        win[0] = {a.x * hw + tx, a.y * hh + ty, a.z * 0.5 + 0.5};
+        win[1] = {b.x * hw + tx, b.y * hh + ty, b.z * 0.5 + 0.5};
+        win[2] = {c.x * hw + tx, c.y * hh + ty, c.z * 0.5 + 0.5};
+        minx = std::min(std::min(win[0].x, win[1].x), win[2].x);
+        maxx = std::max(std::max(win[0].x, win[1].x), win[2].x);
+        miny = std::min(std::min(win[0].y, win[1].y), win[2].y);
+        maxy = std::max(std::max(win[0].y, win[1].y), win[2].y);
+    } else {
+        for (int i = 0; i < n; ++i) {
+            win[i] = {cur[i].v[0] * hw + tx, cur[i].v[1] * hh + ty, cur[i].v[2] * 0.5 + 0.5};
+            minx = std::min(minx, win[i].x);
+            maxx = std::max(maxx, win[i].x);
+            miny = std::min(miny, win[i].y);
+            maxy = std::max(maxy, win[i].y);
+        }
     }
     // Clip-space errors (<= 2^-44 M per coordinate) reach window space scaled by the viewport.
     t.margin_xy = kPixelMargin + mc * std::max(hw, hh);
@@ -268,13 +237,13 @@ void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const
     t.y1 = static_cast<int>(std::min(by1, h1));
     t.single = bx0 == bx1 && by0 == by1;
     BoundsPlane plane;
-    if (!t.single) classify_bounds_triangle(t, win, n, plane);
+    if (!t.single) classify_bounds_triangle(t, win, n, minx, maxx, miny, maxy, plane);
     t.first = static_cast<std::uint32_t>(pool.size());
-    pool.insert(pool.end(), win, win + n);
+    for (int i = 0; i < n; ++i) pool.push_back(win[i]);
     if (t.kind == BoundsTri::Kind::Plane) {
-        BoundsVertex slots[kPlaneSlots];
-        std::memcpy(static_cast<void*>(slots), &plane, sizeof plane);
-        pool.insert(pool.end(), slots, slots + kPlaneSlots);
+        const std::size_t at = pool.size();
+        pool.resize(at + kPlaneSlots);
+        std::memcpy(static_cast<void*>(pool.data() + at), &plane, sizeof plane);
     }
     out.push_back(t);
 }

@@ -146,8 +146,37 @@ struct BoundsP3 {
     double v[3];
 };
 
-// Sutherland-Hodgman against the closed half-space s * p[axis] <= bound (exact_bounds.cpp).
-int bounds_clip_axis(const BoundsP3* in, int n, BoundsP3* out, int axis, double s, double bound);
+// Sutherland-Hodgman against the closed half-space s * p[axis] <= bound (s = +1 or -1): keeps the
+// points with d = bound - s * p[axis] >= 0. A point or a segment (degenerate input) goes through the
+// same loop and stays a point or a segment. New points lie on the edge between the two points they
+// came from (0 <= t <= 1 in floating point too), so their depth never leaves the edge's range.
+//
+// A convex polygon gains at most one vertex per plane (<= 13 in all), but rounding can make a
+// computed polygon very slightly non-convex; should the output ever not fit kBoundsMaxVerts, the
+// input is returned unclipped: a superset, so still conservative (the margins are sized from the
+// input magnitude, so they hold for unclipped coordinates too). Inline: the general path clips
+// every row with a constant axis and sign (s * p is then a negation or nothing: exact either way).
+inline int bounds_clip_axis(const BoundsP3* in, int n, BoundsP3* out, int axis, double s, double bound) {
+    int m = 0;
+    for (int i = 0; i < n; ++i) {
+        const BoundsP3& cur = in[i];
+        const BoundsP3& nxt = in[i + 1 == n ? 0 : i + 1];
+        const double dc = bound - s * cur.v[axis];
+        const double dn = bound - s * nxt.v[axis];
+        if (m + 2 > kBoundsMaxVerts) {
+            std::copy(in, in + n, out);
+            return n;
+        }
+        if (dc >= 0.0) out[m++] = cur;
+        if ((dc >= 0.0) != (dn >= 0.0)) {
+            const double t = dc / (dc - dn);
+            BoundsP3 p{};
+            for (int k = 0; k < 3; ++k) p.v[k] = cur.v[k] + t * (nxt.v[k] - cur.v[k]);
+            out[m++] = p;
+        }
+    }
+    return m;
+}
 
 // Pixel boxes at most this wide also clamp the plane path's depth to each column slab's range.
 inline constexpr int kTightColumns = 32;
@@ -209,7 +238,8 @@ inline void slab_edges(const BoundsVertex* v, int n, SlabEdge* e) {
 // vertices inside the slab and the edges' crossings of its two sides (a linear function's extremes
 // over a convex set lie on its boundary); crossings are interpolated along the edge and clamped to
 // its depth range. Empty (zlo > zhi) when nothing of the polygon is inside.
-inline void slab_depth_range(const SlabEdge* e, int n, double lo, double hi, double& zlo, double& zhi) {
+__attribute__((always_inline)) inline void slab_depth_range(const SlabEdge* e, int n, double lo, double hi,
+                                                            double& zlo, double& zhi) {
     zlo = __builtin_inf();
     zhi = -__builtin_inf();
     for (int i = 0; i < n; ++i) {
