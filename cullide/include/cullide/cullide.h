@@ -16,8 +16,10 @@
 //     ObjectStage);
 //  3. sub-objects: each live object split into groups of `subobject_triangles` consecutive
 //     triangles; in each pass all sub-objects of an object are queried before any is written;
-//  4. exact: surviving sub-objects paired across objects by box overlap (sweep and prune), then
-//     their triangle pairs by box overlap, then the exact test of tri_tri.h.
+//  4. exact: per pair of objects whose live boxes overlap, the live sub-objects meeting the two
+//     boxes' intersection swept and pruned on their boxes (or on their triangles' boxes when the
+//     sub-object boxes are loose), then the triangle pairs whose boxes overlap, then the exact test
+//     of tri_tri.h.
 // Pass k of a view: clear depth; for each live object in order (pass 1) or reverse order (pass 2):
 // query its live items (GEQUAL, depth mask off, one any-samples query each), then write them
 // (LEQUAL, mask on). An item whose queries pass no sample in both passes is fully visible with
@@ -113,7 +115,8 @@ struct CullideStats {
     std::uint64_t pcs_objects = 0;      // objects in the PCS after the triangle stage
     std::uint64_t subobjects = 0;       // sub-objects entering the sub-object stage
     std::uint64_t pcs_subobjects = 0;   // sub-objects left after it
-    std::uint64_t subobject_pairs = 0;  // sub-object pairs across objects whose boxes overlap
+    std::uint64_t subobject_pairs = 0;  // sub-object pairs across objects holding a triangle pair
+                                        // whose boxes overlap (a pair the exact stage tests)
     std::uint64_t candidate_triangles = 0;  // triangles in the surviving sub-objects
     std::uint64_t exact_tests = 0;      // triangle pairs sent to the exact test (boxes overlap)
     std::uint64_t queries = 0;
