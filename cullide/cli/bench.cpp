@@ -47,7 +47,7 @@ constexpr const char* kBenchUsage =
     "  --scales LIST         scene size factors, each in (0, 100] (default 1)\n"
     "  --methods LIST        methods (default exact,cullide,rcullide; 'all' = every method)\n"
     "  --resolutions LIST    view resolutions, each 16..16384 (default: each method's own, 32 for\n"
-    "                        rcullide, 1024 for the others)\n"
+    "                        rcullide and qcullide, 1024 for the others)\n"
     "  --depth-formats LIST  d16, d24, d32f (default d24)\n"
     "  --threads LIST        worker threads, each 0..1024, 0 = all cores (default 0)\n"
     "  --frames N            frames per scene, 1..100000 (default 5)\n"

@@ -85,7 +85,9 @@ Result<raster::DepthFormat> parse_depth_format(std::string_view name) {
 }
 
 int default_resolution(Method m) {
-    return m == Method::RCullide ? kDefaultResolutionRCullide : kDefaultResolutionOthers;
+    return m == Method::RCullide   ? kDefaultResolutionRCullide
+           : m == Method::QCullide ? kDefaultResolutionQCullide
+                                   : kDefaultResolutionOthers;
 }
 
 Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOptions& options) {

@@ -366,7 +366,7 @@ TEST_CASE("resolution 0 means each method's own default resolution") {
     auto scene = cullide::make_scene("cylinders", so);
     REQUIRE(scene.ok());
     const cullide::Frame objects = scene.value()->frame(0);
-    for (Method m : {Method::Cullide, Method::RCullide, Method::QCullideGL}) {
+    for (Method m : {Method::Cullide, Method::RCullide, Method::QCullide, Method::QCullideGL}) {
         CAPTURE(cullide::to_string(m));
         cullide::RunOptions implicit;
         implicit.method = m;
@@ -382,6 +382,8 @@ TEST_CASE("resolution 0 means each method's own default resolution") {
         CHECK(a.value().stats.pcs_subobjects == b.value().stats.pcs_subobjects);
         CHECK(a.value().stats.triangles_rasterized == b.value().stats.triangles_rasterized);
     }
-    // And the defaults differ where they should (rcullide low, the pixel-centre methods high).
+    // And the defaults differ where they should (the exact-bounds methods low, the pixel-centre
+    // methods high).
     CHECK(cullide::default_resolution(Method::RCullide) < cullide::default_resolution(Method::Cullide));
+    CHECK(cullide::default_resolution(Method::QCullide) < cullide::default_resolution(Method::QCullideGL));
 }

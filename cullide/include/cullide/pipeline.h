@@ -46,10 +46,12 @@ enum class BroadPhase { None, SpatialHash, SweepAndPrune, BruteForce };
 // Names accepted by parse_method, in order.
 [[nodiscard]] std::vector<std::string> method_names();
 
-// Default view resolution per method (pixels per side), measured (docs/cullide.md, "Defaults"):
-// rcullide's cost falls with the resolution while the exact stage removes the extra false
-// positives, so it runs best low; the pixel-centre methods miss less at high resolution.
+// Default view resolution per method (pixels per side), measured (docs/cullide.md, "Defaults";
+// docs/quick-cullide.md): the exact-bounds methods (rcullide, qcullide) never miss, their cost falls
+// with the resolution and the exact stage removes the extra false positives, so they run best low;
+// the pixel-centre methods miss less at high resolution.
 inline constexpr int kDefaultResolutionRCullide = 32;
+inline constexpr int kDefaultResolutionQCullide = 32;
 inline constexpr int kDefaultResolutionOthers = 1024;
 [[nodiscard]] int default_resolution(Method m);
 
