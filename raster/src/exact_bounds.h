@@ -442,49 +442,21 @@ inline void bounds_pixels(const BoundsTri& tri, const BoundsVertex* pool, int rx
             }
             continue;
         }
-        // Per edge once per row: its ends, dz/dX (0 when vertical) and depth range.
-        struct RowEdge {
-            double xp, xq, zp, zq, slope, zmin, zmax;
-        };
-        RowEdge edges[kBoundsMaxVerts];
+        // Per edge once per row: its ends in X, dz/dX (0 when vertical) and depth range; per pixel,
+        // the range over the column is read off them by slab_depth_range, as the column path does
+        // (each vertex starts one edge of the closed row polygon, so every vertex is seen).
+        SlabEdge edges[kBoundsMaxVerts];
         for (int i = 0; i < rn; ++i) {
             const BoundsP3& p = rp[i];
             const BoundsP3& q = rp[i + 1 == rn ? 0 : i + 1];
-            RowEdge& e = edges[i];
-            e.xp = p.v[0];
-            e.xq = q.v[0];
-            e.zp = p.v[2];
-            e.zq = q.v[2];
-            e.slope = e.xq != e.xp ? (e.zq - e.zp) / (e.xq - e.xp) : 0.0;
-            e.zmin = std::min(e.zp, e.zq);
-            e.zmax = std::max(e.zp, e.zq);
+            const double tp = p.v[0], tq = q.v[0];
+            edges[i] = {tp, tq, p.v[2], tq != tp ? (q.v[2] - p.v[2]) / (tq - tp) : 0.0, std::min(p.v[2], q.v[2]),
+                        std::max(p.v[2], q.v[2])};
         }
         for (int px = xs; px <= xe; ++px) {
             const double fx = static_cast<double>(px);
-            const double xl = fx - m, xr = fx + 1.0 + m;
-            double zlo = kInf, zhi = -kInf;
-            for (int i = 0; i < rn; ++i) {
-                const RowEdge& e = edges[i];
-                if ((e.xp < xl && e.xq < xl) || (e.xp > xr && e.xq > xr)) continue;
-                if (e.xp >= xl && e.xp <= xr) {
-                    zlo = std::min(zlo, e.zp);
-                    zhi = std::max(zhi, e.zp);
-                }
-                if (e.xq >= xl && e.xq <= xr) {
-                    zlo = std::min(zlo, e.zq);
-                    zhi = std::max(zhi, e.zq);
-                }
-                if ((e.xp < xl && e.xq > xl) || (e.xp > xl && e.xq < xl)) {
-                    const double z = std::clamp(e.zp + (xl - e.xp) * e.slope, e.zmin, e.zmax);
-                    zlo = std::min(zlo, z);
-                    zhi = std::max(zhi, z);
-                }
-                if ((e.xp < xr && e.xq > xr) || (e.xp > xr && e.xq < xr)) {
-                    const double z = std::clamp(e.zp + (xr - e.xp) * e.slope, e.zmin, e.zmax);
-                    zlo = std::min(zlo, z);
-                    zhi = std::max(zhi, z);
-                }
-            }
+            double zlo, zhi;
+            slab_depth_range(edges, rn, fx - m, fx + 1.0 + m, zlo, zhi);
             if (zlo <= zhi) f(px, py, zlo, zhi);
         }
     }
