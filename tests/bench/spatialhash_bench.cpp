@@ -128,8 +128,6 @@ const Scene& scene(std::size_t n, int kind) {
     return sc;
 }
 
-bool aabb_overlap(const Box& x, const Box& y) { return spatialhash::overlaps(x, y); }
-
 void report(benchmark::State& state, const Scene& sc, std::size_t pairs) {
     state.counters["pairs_f0"] = static_cast<double>(sc.truth.size());
     state.counters["pairs_last"] = static_cast<double>(pairs);
@@ -315,7 +313,7 @@ void bm_bullet(benchmark::State& state, BulletKind kind) {
         for (int p = 0; p < count; ++p) {
             const auto a = static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(pairs[p].m_pProxy0->m_clientObject));
             const auto b = static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(pairs[p].m_pProxy1->m_clientObject));
-            if (aabb_overlap(sc.frames[f][a], sc.frames[f][b])) {
+            if (spatialhash::overlaps(sc.frames[f][a], sc.frames[f][b])) {
                 ++exact;
                 if (out) out->push_back(Pair{std::min(a, b), std::max(a, b)});
             }
