@@ -1,20 +1,21 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages cullide needs, only those missing (so a second run does nothing).
 # usage: scripts/deps.sh run|test|fuzz|bench
-#   run   what the library and the CLI need
-#   test  + the test and benchmark dependencies and the oracles (doctest, GMP, OSMesa, Embree, Benchmark)
+#   run   what the library and the CLI need (oneTBB; the build tools)
+#   test  + the test and benchmark dependencies and the oracles (Eigen for the Eigen front door,
+#         doctest, GMP, OSMesa, Embree, Benchmark)
 #   fuzz  + clang with libFuzzer
 #   bench + the peers of peers_bench (FCL, Bullet, CGAL) and matplotlib for scripts/plots.py and
 #         scripts/plot_spatialhash.py (FCL and Bullet are also spatialhash_bench's peers)
 #         (benchmark-only: never dependencies of the libraries)
 set -euo pipefail
 
-want=(cmake ninja-build g++ pkg-config libeigen3-dev libtbb-dev)
+want=(cmake ninja-build g++ pkg-config libtbb-dev)
 case "${1:-run}" in
   run) ;;
-  test) want+=(doctest-dev libgmp-dev libosmesa6-dev libembree-dev libbenchmark-dev) ;;
-  fuzz) want+=(doctest-dev libgmp-dev libosmesa6-dev libembree-dev libbenchmark-dev clang libclang-rt-14-dev) ;;
-  bench) want+=(doctest-dev libgmp-dev libosmesa6-dev libembree-dev libbenchmark-dev libfcl-dev libbullet-dev
+  test) want+=(libeigen3-dev doctest-dev libgmp-dev libosmesa6-dev libembree-dev libbenchmark-dev) ;;
+  fuzz) want+=(libeigen3-dev doctest-dev libgmp-dev libosmesa6-dev libembree-dev libbenchmark-dev clang libclang-rt-14-dev) ;;
+  bench) want+=(libeigen3-dev doctest-dev libgmp-dev libosmesa6-dev libembree-dev libbenchmark-dev libfcl-dev libbullet-dev
                libcgal-dev python3-matplotlib) ;;
   *) echo "usage: $0 run|test|fuzz|bench" >&2; exit 2 ;;
 esac
