@@ -311,7 +311,7 @@ TEST_CASE("every method refuses coordinates outside the exact range, as the grou
     // Regression of fuzz/findings/pipeline: rcullide accepted a subnormal coordinate exact refused.
     std::vector<cullide::Mesh> objects(2);
     for (int o = 0; o < 2; ++o) {
-        objects[static_cast<std::size_t>(o)].name = "m" + std::to_string(o);
+        objects[static_cast<std::size_t>(o)].name = std::string("m").append(std::to_string(o));
         objects[static_cast<std::size_t>(o)].positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
         objects[static_cast<std::size_t>(o)].triangles = {{0, 1, 2}};
     }
@@ -337,7 +337,7 @@ TEST_CASE("a view 2^-195 thin along one axis does not overflow the offset solids
     // view scale near 2^195, and rcullide-offset failed with "its box overflows float in clip
     // space" on a scene the ground truth accepts. The solids are now saturated in double first.
     std::vector<cullide::Mesh> objects(2);
-    for (int o = 0; o < 2; ++o) objects[static_cast<std::size_t>(o)].name = "m" + std::to_string(o);
+    for (int o = 0; o < 2; ++o) objects[static_cast<std::size_t>(o)].name = std::string("m").append(std::to_string(o));
     objects[0].positions = {{0x1.5cp+1, -0x1.ac8f1032405ffp-195, 0x1.c8p+0}, {0, 0, 0}};
     objects[0].triangles = {{0, 0, 0}, {0, 1, 1}};
     objects[1].positions = {{0, 0, 0}, {1, 0, 0.5}};

@@ -158,13 +158,13 @@ std::vector<Case> make_cases() {
         // A thousand identical one-triangle objects: every one of the 499,500 object pairs collides.
         Case c{"a thousand identical triangles", {}, Expect::AllPairs};
         for (int i = 0; i < 1000; ++i) {
-            c.objects.push_back(triangle_mesh("t" + std::to_string(i), {0, 0, 0}, {1, 0, 0.25}, {0, 1, 0.5}));
+            c.objects.push_back(triangle_mesh(std::string("t").append(std::to_string(i)), {0, 0, 0}, {1, 0, 0.25}, {0, 1, 0.5}));
         }
         cases.push_back(std::move(c));
     }
     {
         Case c{"forty identical cubes", {}, Expect::AllPairs};
-        for (int i = 0; i < 40; ++i) c.objects.push_back(box_mesh("c" + std::to_string(i), o, one));
+        for (int i = 0; i < 40; ++i) c.objects.push_back(box_mesh(std::string("c").append(std::to_string(i)), o, one));
         cases.push_back(std::move(c));
     }
     return cases;
