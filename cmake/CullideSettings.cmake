@@ -43,7 +43,8 @@ if(CULLIDE_BUILD_FUZZERS)
   add_link_options(-fsanitize=address,undefined)
 endif()
 
-# One call for every project target.
+# One call for every project target. Build-only: an installed static library must not pass our
+# warning and floating-point flags on to the programs that link it.
 function(cullide_target_defaults target)
-  target_link_libraries(${target} PRIVATE cullide::warnings cullide::fp)
+  target_link_libraries(${target} PRIVATE $<BUILD_INTERFACE:cullide::warnings> $<BUILD_INTERFACE:cullide::fp>)
 endfunction()
