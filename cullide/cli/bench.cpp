@@ -1,9 +1,8 @@
-// cullide/cli/bench.cpp: the engine of `cullide bench` and `cullide sweep` (bench.h), and bench's
-// options and output (CSV, JSON, a table on stdout).
+// cullide/cli/bench.cpp: the engine of `cullide bench` and `cullide sweep` (bench.h) and their output
+// (CSV, JSON, a table on stdout). Their options are rows of the option table (options.cpp).
 #include "bench.h"
 
 #include <algorithm>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -22,6 +21,8 @@
 #include <unistd.h>
 
 #include "bench_internal.h"
+#include "help.h"
+#include "options.h"
 #include "cullide/scenes.h"
 
 namespace cullide::cli {
@@ -30,201 +31,27 @@ using namespace bench_detail;
 
 namespace {
 
-constexpr const char* kBenchUsage =
-    "usage: cullide bench [options]\n"
-    "\n"
-    "Times methods frame by frame on built-in scenes. Each frame of each combination scene x scale x\n"
-    "method x resolution x depth format x threads runs --warmup untimed times, then --reps timed\n"
-    "times; the time of a frame is the median of its repetitions. Before any time is reported the\n"
-    "pairs are checked: every repetition must give the same pairs (digest), no reported pair may be\n"
-    "rejected by the exact test, and a method that never misses (exact, rcullide, rcullide-offset,\n"
-    "qcullide)\n"
-    "must give exactly the ground truth's pairs; otherwise the command fails (exit 1) naming the\n"
-    "scene, method and frame. Methods that may miss (cullide) are reported with their misses.\n"
-    "\n"
-    "options (LIST = comma-separated values):\n"
-    "  --scenes LIST         built-in scenes (default cylinders; 'all' = every scene)\n"
-    "  --scales LIST         scene size factors, each in (0, 100] (default 1)\n"
-    "  --methods LIST        methods (default exact,cullide,rcullide; 'all' = every method)\n"
-    "  --resolutions LIST    view resolutions, each 16..16384 (default: each method's own, 32 for\n"
-    "                        rcullide and qcullide, 1024 for the others)\n"
-    "  --depth-formats LIST  d16, d24, d32f (default d24)\n"
-    "  --threads LIST        worker threads, each 0..1024, 0 = all cores (default 0)\n"
-    "  --frames N            frames per scene, 1..100000 (default 5)\n"
-    "  --first-frame F       first frame index (default 0)\n"
-    "  --frame-step K        frame index step, 1..100000 (default 1)\n"
-    "  --warmup N            untimed runs per frame, 0..1000 (default 1)\n"
-    "  --reps N              timed runs per frame, 1..1000 (default 5)\n"
-    "  --subobject N, --rounds N, --min-prune F, --object-stage S, --broadphase B, --self, --seed S,\n"
-    "  --mesh-dir DIR: as 'cullide run'\n"
-    "  --csv FILE            write one CSV row per combination ('-' = stdout)\n"
-    "  --json FILE           write a JSON document ('-' = stdout)\n"
-    "  --no-progress         no progress bar (it is drawn on stderr only when stderr is a terminal)\n"
-    "\n"
-    "Times are wall-clock milliseconds per frame (frame generation excluded); counts (pairs, false\n"
-    "negatives, PCS sizes, queries) are totals over the frames. The load average is recorded.\n";
-
-template <class T>
-std::optional<T> parse_int(std::string_view s) {
-    T v{};
-    auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (s.empty() || ec != std::errc() || ptr != s.data() + s.size()) return std::nullopt;
-    return v;
-}
-
-std::optional<double> parse_real(std::string_view s) {
-    double v = 0;
-    auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (s.empty() || ec != std::errc() || ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
-    return v;
-}
-
-std::vector<std::string> split_list(const std::string& option, const std::string& v) {
-    std::vector<std::string> parts;
-    std::size_t start = 0;
-    while (true) {
-        const std::size_t comma = v.find(',', start);
-        std::string item = v.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-        if (item.empty()) throw BenchUsageError{option + ": empty item in list '" + v + "'"};
-        parts.push_back(std::move(item));
-        if (comma == std::string::npos) break;
-        start = comma + 1;
-    }
-    return parts;
-}
-
-int int_in(const std::string& option, const std::string& v, int lo, int hi) {
-    auto n = parse_int<int>(v);
-    if (!n || *n < lo || *n > hi) {
-        throw BenchUsageError{option + " must be an integer in " + std::to_string(lo) + ".." + std::to_string(hi) +
-                              " (got '" + v + "')"};
-    }
-    return *n;
-}
-
-bool is_scene(const std::string& name) {
-    const std::vector<std::string> names = scene_names();
-    return std::find(names.begin(), names.end(), name) != names.end();
-}
-
-std::string joined(const std::vector<std::string>& v) {
-    std::string s;
-    for (const std::string& x : v) s += (s.empty() ? "" : ", ") + x;
-    return s;
-}
-
-BenchArgs parse_args(const std::vector<std::string>& args) {
+// bench's and sweep's settings, after the table filled in their defaults.
+BenchArgs bench_args_of(Command command, const Settings& s) {
+    if (s.csv_path == "-" && s.json_path == "-") throw UsageError{"--csv - and --json - cannot both go to stdout"};
     BenchArgs a;
-    a.sweep = args[0] == "sweep";
-    a.warmup = -1;
-    auto value = [&](std::size_t& i) -> const std::string& {
-        if (i + 1 >= args.size()) throw BenchUsageError{"option " + args[i] + " needs a value"};
-        return args[++i];
-    };
-    for (std::size_t i = 1; i < args.size(); ++i) {
-        const std::string& o = args[i];
-        if (o == "--scenes") {
-            a.scenes.clear();  // a repeated option replaces the list
-            for (const std::string& s : split_list(o, value(i))) {
-                if (s == "all") {
-                    for (const std::string& n : scene_names()) a.scenes.push_back(n);
-                } else if (!is_scene(s)) {
-                    throw BenchUsageError{"--scenes: unknown scene '" + s + "' (valid: " + joined(scene_names()) + ", all)"};
-                } else {
-                    a.scenes.push_back(s);
-                }
-            }
-        } else if (o == "--scales") {
-            a.scales.clear();  // a repeated option replaces the list
-            for (const std::string& s : split_list(o, value(i))) {
-                auto x = parse_real(s);
-                if (!x || !(*x > 0) || *x > 100) throw BenchUsageError{"--scales: each must be a number in (0, 100] (got '" + s + "')"};
-                a.scales.push_back(*x);
-            }
-        } else if (o == "--methods") {
-            a.methods.clear();  // a repeated option replaces the list
-            for (const std::string& s : split_list(o, value(i))) {
-                if (s == "all") {
-                    for (const std::string& n : method_names()) a.methods.push_back(parse_method(n).value());
-                    continue;
-                }
-                Result<Method> m = parse_method(s);
-                if (!m) throw BenchUsageError{"--methods: " + m.error().message};
-                a.methods.push_back(m.value());
-            }
-        } else if (o == "--resolutions") {
-            a.resolutions.clear();  // a repeated option replaces the list
-            for (const std::string& s : split_list(o, value(i))) a.resolutions.push_back(int_in(o, s, 16, 16384));
-        } else if (o == "--depth-formats") {
-            a.depth_formats.clear();  // a repeated option replaces the list
-            for (const std::string& s : split_list(o, value(i))) {
-                Result<raster::DepthFormat> f = parse_depth_format(s);
-                if (!f) throw BenchUsageError{"--depth-formats: " + f.error().message};
-                a.depth_formats.push_back(f.value());
-            }
-        } else if (o == "--threads") {
-            a.threads.clear();  // a repeated option replaces the list
-            for (const std::string& s : split_list(o, value(i))) a.threads.push_back(int_in(o, s, 0, 1024));
-        } else if (o == "--frames") {
-            a.frames = int_in(o, value(i), 1, 100000);
-        } else if (o == "--first-frame") {
-            a.first_frame = int_in(o, value(i), -1000000, 1000000);
-        } else if (o == "--frame-step") {
-            a.frame_step = int_in(o, value(i), 1, 100000);
-        } else if (o == "--warmup") {
-            a.warmup = int_in(o, value(i), 0, 1000);
-        } else if (o == "--reps") {
-            a.reps = int_in(o, value(i), 1, 1000);
-        } else if (o == "--subobject") {
-            a.base.subobject_triangles = int_in(o, value(i), 1, 65536);
-        } else if (o == "--rounds") {
-            a.base.max_rounds = int_in(o, value(i), 1, 1000);
-        } else if (o == "--min-prune") {
-            const std::string& v = value(i);
-            auto x = parse_real(v);
-            if (!x || !(*x >= 0) || !(*x < 1)) throw BenchUsageError{"--min-prune must be a number in [0, 1) (got '" + v + "')"};
-            a.base.min_prune = *x;
-        } else if (o == "--object-stage") {
-            const std::string& v = value(i);
-            if (v == "auto") a.base.object_stage = ObjectStage::Auto;
-            else if (v == "on") a.base.object_stage = ObjectStage::On;
-            else if (v == "off") a.base.object_stage = ObjectStage::Off;
-            else throw BenchUsageError{"--object-stage must be auto, on or off (got '" + v + "')"};
-        } else if (o == "--broadphase") {
-            Result<BroadPhase> b = parse_broadphase(value(i));
-            if (!b) throw BenchUsageError{"--broadphase: " + b.error().message};
-            a.base.broadphase = b.value();
-        } else if (o == "--self") {
-            a.base.self = true;
-        } else if (o == "--seed") {
-            const std::string& v = value(i);
-            auto n = parse_int<std::uint64_t>(v);
-            if (!n) throw BenchUsageError{"--seed must be an unsigned 64-bit integer (got '" + v + "')"};
-            a.scene_options.seed = *n;
-        } else if (o == "--mesh-dir") {
-            a.scene_options.mesh_dir = value(i);
-        } else if (o == "--csv") {
-            a.csv_path = value(i);
-        } else if (o == "--json") {
-            a.json_path = value(i);
-        } else if (o == "--no-progress") {
-            a.progress = false;
-        } else {
-            throw BenchUsageError{"unknown option '" + o + "'" +
-                                  (o.empty() || o[0] != '-' ? " (scenes are given with --scenes)" : "")};
-        }
-    }
-    if (a.csv_path == "-" && a.json_path == "-") throw BenchUsageError{"--csv - and --json - cannot both go to stdout"};
-    if (a.sweep) apply_sweep_defaults(a);
-    if (a.scenes.empty()) a.scenes = {"cylinders"};
-    if (a.scales.empty()) a.scales = {1.0};
-    if (a.methods.empty()) a.methods = {Method::Exact, Method::Cullide, Method::RCullide};
-    // No --resolutions: each visibility method at its own default (pipeline.h default_resolution).
-    if (a.depth_formats.empty()) a.depth_formats = {a.base.depth_format};
-    if (a.threads.empty()) a.threads = {0};
-    if (a.frames == 0) a.frames = 5;
-    if (a.warmup < 0) a.warmup = 1;
-    if (a.reps == 0) a.reps = 5;
+    a.sweep = command == Command::Sweep;
+    a.scenes = s.scenes;
+    a.scales = s.scales;
+    a.methods = s.methods;
+    a.resolutions = s.resolutions;  // empty: each visibility method at its own default_resolution
+    a.depth_formats = s.depth_formats;
+    a.threads = s.thread_counts;
+    a.frames = s.frames.value();  // every one of these has a default in the option table
+    a.first_frame = s.first_frame;
+    a.frame_step = s.frame_step;
+    a.warmup = s.warmup.value();
+    a.reps = s.reps.value();
+    a.base = s.pipeline;
+    a.scene_options = s.scene;
+    a.csv_path = s.csv_path;
+    a.json_path = s.json_path;
+    a.progress = s.progress;
     return a;
 }
 
@@ -434,9 +261,9 @@ int run_bench(const BenchArgs& a, std::ostream& out, std::ostream& err, const Fr
             // The ground truth of each frame, once per scene and scale.
             std::vector<std::vector<TrianglePair>> truth;
             for (std::size_t f = 0; f < frames.size(); ++f) {
-                RunOptions o = a.base;
-                o.method = Method::Exact;
-                Result<FrameResult> r = process_frame(frames[f], o);
+                PipelineSettings p = a.base;
+                p.method = Method::Exact;
+                Result<FrameResult> r = process_frame(frames[f], to_run_options(p));
                 if (!r) {
                     err << "cullide: error: scene " << scene << " frame " << frame_index[f]
                         << ": ground truth: " << r.error().message << "\n";
@@ -461,11 +288,12 @@ int run_bench(const BenchArgs& a, std::ostream& out, std::ostream& err, const Fr
                             c.resolution = resolution;
                             c.depth_format = df;
                             c.threads = threads;
-                            RunOptions o = a.base;
-                            o.method = m;
-                            o.resolution = resolution;
-                            o.depth_format = df;
-                            o.threads = threads;
+                            PipelineSettings p = a.base;
+                            p.method = m;
+                            p.resolution = resolution;
+                            p.depth_format = df;
+                            p.threads = threads;
+                            const RunOptions o = to_run_options(p);
                             std::ostringstream label;
                             label << scene << " " << to_string(m) << " " << resolution << " " << to_string(df);
                             progress.step(done, label.str());
@@ -610,21 +438,20 @@ bool never_misses(Method m) {
 
 int bench_command(const std::vector<std::string>& args, std::ostream& out, std::ostream& err,
                   const FrameRunner* runner) {
-    const bool sweep = !args.empty() && args[0] == "sweep";
-    const char* name = sweep ? "sweep" : "bench";
+    const Command command = !args.empty() && args[0] == "sweep" ? Command::Sweep : Command::Bench;
+    const char* name = command_name(command);
     try {
-        for (std::size_t i = 1; i < args.size(); ++i) {
-            if (args[i] == "--help" || args[i] == "-h") {
-                out << (sweep ? kSweepUsage : kBenchUsage);
-                return 0;
-            }
+        const Settings settings = parse_options(command, args);
+        if (settings.help) {
+            out << command_help(command);
+            return 0;
         }
-        const BenchArgs a = parse_args(args);
+        const BenchArgs a = bench_args_of(command, settings);
         const FrameRunner process = [](std::span<const Mesh> objects, const RunOptions& o) {
             return process_frame(objects, o);
         };
         return run_bench(a, out, err, runner ? *runner : process);
-    } catch (const BenchUsageError& e) {
+    } catch (const UsageError& e) {
         err << "cullide " << name << ": " << e.message << "\n(run 'cullide " << name << " --help' for usage)\n";
         return 2;
     } catch (const CheckFailure& e) {
