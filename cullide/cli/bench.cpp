@@ -291,8 +291,8 @@ FrameRun run_frame(const BenchArgs& a, const FrameRunner& runner, const Frame& f
         if (!r) throw RunFailure{where + ": " + r.error().message};
         const std::uint64_t d = pairs_digest(r.value().pairs);
         if (rep > 0 && fr.digest != d) {
-            throw CheckFailure{where + ": repeated runs gave different pairs (digest " + hex64(fr.digest) + " then " +
-                               hex64(d) + "): the method is not deterministic"};
+            throw CheckFailure{where + ": repeated runs gave different pairs (digest " + hex64(fr.digest) +
+                               " then " + hex64(d) + "): the method is not deterministic"};
         }
         fr.digest = d;
         if (rep >= a.warmup) fr.reps_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
@@ -302,7 +302,8 @@ FrameRun run_frame(const BenchArgs& a, const FrameRunner& runner, const Frame& f
 }
 
 // Adds one frame's figures to its row (objects and triangles as means over `frames`).
-void accumulate(CaseResult& c, const FrameRun& fr, const Comparison& cmp, std::size_t truth_pairs, std::size_t frames) {
+void accumulate(CaseResult& c, const FrameRun& fr, const Comparison& cmp, std::size_t truth_pairs,
+                std::size_t frames) {
     const FrameStats& s = fr.kept.stats;
     c.objects += static_cast<double>(s.objects) / static_cast<double>(frames);
     c.triangles += static_cast<double>(s.triangles) / static_cast<double>(frames);
@@ -349,8 +350,8 @@ CaseResult run_case(const BenchArgs& a, const FrameRunner& runner, const SceneFr
         if (cmp.false_negatives != 0) {
             misses = true;
             if (never_misses(c.method)) {
-                const std::string msg = where + ": digest mismatch: " + hex64(fr.digest) + " vs ground truth " +
-                                        hex64(pairs_digest(sf.truth[f])) + ", " +
+                const std::string msg = where + ": digest mismatch: " + hex64(fr.digest) +
+                                        " vs ground truth " + hex64(pairs_digest(sf.truth[f])) + ", " +
                                         std::to_string(cmp.false_negatives) +
                                         " colliding pair(s) missed by a method that never misses";
                 if (!a.sweep) throw CheckFailure{msg};
@@ -375,14 +376,15 @@ std::ostream* open_csv(const BenchArgs& a, std::ostream& out, std::ofstream& fil
 }
 
 void print_table_header(std::ostream& out, const BenchArgs& a, double load_start) {
-    out << "cullide " << (a.sweep ? "sweep" : "bench") << ": " << a.frames << " frame(s) from " << a.first_frame
-        << " step " << a.frame_step << ", warm-up " << a.warmup << ", " << a.reps << " rep(s); load " << std::fixed
-        << std::setprecision(2) << load_start << std::defaultfloat << " on " << std::thread::hardware_concurrency()
-        << " hardware threads\n";
+    out << "cullide " << (a.sweep ? "sweep" : "bench") << ": " << a.frames << " frame(s) from "
+        << a.first_frame << " step " << a.frame_step << ", warm-up " << a.warmup << ", " << a.reps
+        << " rep(s); load " << std::fixed << std::setprecision(2) << load_start << std::defaultfloat << " on "
+        << std::thread::hardware_concurrency() << " hardware threads\n";
     out << std::left << std::setw(13) << "scene" << std::setw(6) << "scale" << std::setw(16) << "method"
-        << std::setw(6) << "res" << std::setw(5) << "dep" << std::setw(4) << "thr" << std::right << std::setw(10)
-        << "ms/frame" << std::setw(10) << "median" << std::setw(22) << "[min, max]" << std::setw(9) << "pairs"
-        << std::setw(8) << "misses" << std::setw(10) << "false+" << "  check\n";
+        << std::setw(6) << "res" << std::setw(5) << "dep" << std::setw(4) << "thr" << std::right
+        << std::setw(10) << "ms/frame" << std::setw(10) << "median" << std::setw(22) << "[min, max]"
+        << std::setw(9) << "pairs" << std::setw(8) << "misses" << std::setw(10) << "false+"
+        << "  check\n";
 }
 
 void print_table_row(std::ostream& out, const CaseResult& c) {
@@ -391,8 +393,8 @@ void print_table_row(std::ostream& out, const CaseResult& c) {
     const bool vis = visibility_method(c.method);
     std::ostringstream spread;
     spread << std::fixed << std::setprecision(2) << "[" << t.min << ", " << t.max << "]";
-    out << std::left << std::setw(13) << c.scene << std::setw(6) << c.scale << std::setw(16) << to_string(c.method)
-        << std::setw(6) << (vis ? std::to_string(c.resolution) : "-") << std::setw(5)
+    out << std::left << std::setw(13) << c.scene << std::setw(6) << c.scale << std::setw(16)
+        << to_string(c.method) << std::setw(6) << (vis ? std::to_string(c.resolution) : "-") << std::setw(5)
         << (vis ? to_string(c.depth_format) : "-") << std::setw(4) << c.threads << std::right << std::fixed
         << std::setprecision(2) << std::setw(10) << t.mean << std::setw(10) << t.median << std::setw(22)
         << spread.str() << std::defaultfloat << std::setw(9) << c.pairs << std::setw(8) << c.false_negatives
@@ -400,7 +402,8 @@ void print_table_row(std::ostream& out, const CaseResult& c) {
     out.flush();
 }
 
-void write_json_to(const BenchArgs& a, const std::vector<CaseResult>& cases, double load_start, std::ostream& out) {
+void write_json_to(const BenchArgs& a, const std::vector<CaseResult>& cases, double load_start,
+                   std::ostream& out) {
     if (a.json_path == "-") {
         write_json(out, a, cases, load_start, load_average());
         return;
@@ -434,8 +437,9 @@ int run_grid(const BenchArgs& a, std::ostream& out, std::ostream& err, const Fra
                 c.resolution = k.resolution;
                 c.depth_format = k.depth_format;
                 c.threads = k.threads;
-                progress.step(cases.size(), scene + " " + to_string(k.method) + " " + std::to_string(k.resolution) +
-                                                " " + to_string(k.depth_format));
+                progress.step(cases.size(), scene + " " + to_string(k.method) + " " +
+                                                std::to_string(k.resolution) + " " +
+                                                to_string(k.depth_format));
                 c = run_case(a, runner, sf, std::move(c), err, mismatch);
                 if (csv) {
                     write_csv_row(*csv, a, c);

@@ -13,7 +13,7 @@
 namespace cullide::cli {
 namespace {
 
-constexpr std::size_t kWidth = 100;       // text help wraps here
+constexpr std::size_t kWidth = 100;        // text help wraps here
 constexpr std::size_t kOptionColumn = 24;  // where an option's description starts
 
 // What the help and the man page say about each command, in the order they are listed.
@@ -30,18 +30,22 @@ constexpr const char* kRunDescription =
     "object per OBJ group, in argument order.";
 
 constexpr const char* kBenchDescription =
-    "Times methods frame by frame on built-in scenes. Each frame of each combination scene x scale x method x "
+    "Times methods frame by frame on built-in scenes. Each frame of each combination scene x scale x method "
+    "x "
     "resolution x depth format x threads runs --warmup untimed times, then --reps timed times; the time of a "
     "frame is the median of its repetitions. Before any time is reported the pairs are checked: every "
     "repetition must give the same pairs (digest), no reported pair may be rejected by the exact test, and a "
     "method that never misses (exact, rcullide, rcullide-offset, qcullide) must give exactly the ground "
-    "truth's pairs; otherwise the command fails (exit 1) naming the scene, method and frame. Methods that may "
+    "truth's pairs; otherwise the command fails (exit 1) naming the scene, method and frame. Methods that "
+    "may "
     "miss (cullide) are reported with their misses. Times are wall-clock milliseconds per frame (frame "
-    "generation excluded); counts (pairs, false negatives, PCS sizes, queries) are totals over the frames. The "
+    "generation excluded); counts (pairs, false negatives, PCS sizes, queries) are totals over the frames. "
+    "The "
     "load average is recorded.";
 
 constexpr const char* kSweepDescription =
-    "Runs every combination scene x scale x method x resolution x depth format x threads over the same frames "
+    "Runs every combination scene x scale x method x resolution x depth format x threads over the same "
+    "frames "
     "and reports, per combination: time per frame, PCS size per stage, false negatives (true colliding "
     "triangle pairs not reported) and false positives (candidate triangle pairs sent to the exact test that "
     "do not collide) against the ground truth. A method that never misses (exact, rcullide, rcullide-offset, "
@@ -53,7 +57,8 @@ const std::vector<CommandDoc>& command_docs() {
         {"run", "[SCENE...] [options]", "detect colliding triangle pairs, frame by frame", kRunDescription},
         {"scenes", "", "list the built-in scenes", "Lists the built-in scenes, one line each."},
         {"bench", "[options]", "time methods per frame, checked against the ground truth", kBenchDescription},
-        {"sweep", "[options]", "resolution x depth format x method x scene: time, PCS, errors", kSweepDescription},
+        {"sweep", "[options]", "resolution x depth format x method x scene: time, PCS, errors",
+         kSweepDescription},
         {"help", "[COMMAND] [--man]", "this text, or one command's; --man: the manual page (roff)",
          "Prints every command and option; 'cullide help COMMAND' is 'cullide COMMAND --help'; 'cullide help "
          "--man' prints this manual page as roff."},
@@ -106,7 +111,8 @@ std::string description(const OptionSpec& o, Defaults which) {
     } else if (!o.default_text.empty()) {
         notes.push_back("default " + o.default_text);
     }
-    if (which == Defaults::Both && !o.sweep_default.empty()) notes.push_back("sweep: default " + o.sweep_default);
+    if (which == Defaults::Both && !o.sweep_default.empty())
+        notes.push_back("sweep: default " + o.sweep_default);
     std::string s = o.help;
     for (std::size_t i = 0; i < notes.size(); ++i) s += (i == 0 ? " (" : "; ") + notes[i];
     if (!notes.empty()) s += ")";
@@ -151,9 +157,12 @@ std::string roff(std::string_view text) {
     std::string s;
     if (!text.empty() && (text[0] == '.' || text[0] == '\'')) s += "\\&";
     for (char c : text) {
-        if (c == '\\') s += "\\e";
-        else if (c == '-') s += "\\-";
-        else s += c;
+        if (c == '\\')
+            s += "\\e";
+        else if (c == '-')
+            s += "\\-";
+        else
+            s += c;
     }
     return s;
 }
@@ -183,11 +192,13 @@ std::string usage_text() {
         wrap(out, d.summary, head.size(), 19);
     }
     out += '\n';
-    wrap(out, "SCENE is one built-in scene name (default: cylinders) or mesh files (.obj .ply .stl); each file is "
-              "one object, or one object per OBJ group, in argument order.", 0, 0);
+    wrap(out,
+         "SCENE is one built-in scene name (default: cylinders) or mesh files (.obj .ply .stl); each file is "
+         "one object, or one object per OBJ group, in argument order.",
+         0, 0);
     for (CommandSet group : option_groups()) {
-        out += "\noptions of " + command_list(group) + (has_list_value(group) ? " (LIST = comma-separated values)" : "") +
-               ":\n";
+        out += "\noptions of " + command_list(group) +
+               (has_list_value(group) ? " (LIST = comma-separated values)" : "") + ":\n";
         for (const OptionSpec& o : option_table()) {
             if (o.commands == group) append_option(out, o, Defaults::Both);
         }
@@ -200,7 +211,9 @@ std::string command_help(Command command) {
     std::string out = std::string("usage: cullide ") + d.name + " " + d.operands + "\n\n";
     wrap(out, d.description, 0, 0);
     out += "\noptions";
-    out += command == Command::Run ? ":\n" : " (LIST = comma-separated values; a repeated option replaces the list):\n";
+    out += command == Command::Run
+               ? ":\n"
+               : " (LIST = comma-separated values; a repeated option replaces the list):\n";
     const Defaults which = command == Command::Sweep ? Defaults::Sweep : Defaults::Bench;
     for (const OptionSpec& o : option_table()) {
         if (takes(o.commands, command)) append_option(out, o, which);
@@ -223,14 +236,18 @@ std::string man_page() {
     }
     out += ".B cullide \\-\\-version\n";
     out += ".SH DESCRIPTION\n";
-    out += "cullide runs the GPU collision\\-culling algorithms CULLIDE, R\\-CULLIDE and Quick\\-CULLIDE on the CPU "
-           "through a software depth rasterizer, and checks them against an exact ground truth. Results do not "
-           "depend on the thread count.\n";
+    out +=
+        "cullide runs the GPU collision\\-culling algorithms CULLIDE, R\\-CULLIDE and Quick\\-CULLIDE on the "
+        "CPU "
+        "through a software depth rasterizer, and checks them against an exact ground truth. Results do not "
+        "depend on the thread count.\n";
     out += ".SH COMMANDS\n";
-    for (const CommandDoc& d : command_docs()) out += ".TP\n.B " + roff(d.name) + "\n" + roff(d.description) + "\n";
+    for (const CommandDoc& d : command_docs())
+        out += ".TP\n.B " + roff(d.name) + "\n" + roff(d.description) + "\n";
     append_man_options(out);
     out += ".SH \"EXIT STATUS\"\n0 success; 1 bad input, a failed run or a failed check; 2 bad usage.\n";
-    out += ".SH \"SEE ALSO\"\nREADME.md and docs/ in the source tree: docs/architecture.md, docs/results.md.\n";
+    out +=
+        ".SH \"SEE ALSO\"\nREADME.md and docs/ in the source tree: docs/architecture.md, docs/results.md.\n";
     return out;
 }
 

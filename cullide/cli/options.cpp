@@ -28,20 +28,24 @@ std::optional<T> parse_integer(std::string_view s) {
 std::optional<double> parse_real(std::string_view s) {
     double v = 0;
     auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (s.empty() || ec != std::errc() || ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+    if (s.empty() || ec != std::errc() || ptr != s.data() + s.size() || !std::isfinite(v))
+        return std::nullopt;
     return v;
 }
 
 Range integers(long long lo, long long hi) {
     return Range{Range::Kind::Integer, static_cast<double>(lo), static_cast<double>(hi), false, false};
 }
-Range reals(double lo, bool lo_open, double hi, bool hi_open) { return Range{Range::Kind::Real, lo, hi, lo_open, hi_open}; }
+Range reals(double lo, bool lo_open, double hi, bool hi_open) {
+    return Range{Range::Kind::Real, lo, hi, lo_open, hi_open};
+}
 
 // The value of an integer option (or of one item of a list), checked against spec.range.
 int int_value(const OptionSpec& spec, const std::string& v) {
     const auto n = parse_integer<int>(v);
     if (!n || *n < spec.range.lo || *n > spec.range.hi) {
-        throw UsageError{spec.name + " must be an integer in " + range_text(spec.range) + " (got '" + v + "')"};
+        throw UsageError{spec.name + " must be an integer in " + range_text(spec.range) + " (got '" + v +
+                         "')"};
     }
     return *n;
 }
@@ -54,8 +58,8 @@ bool in_range(const Range& r, double x) {
 double real_value(const OptionSpec& spec, const std::string& v, bool list_item) {
     const auto x = parse_real(v);
     if (!x || !in_range(spec.range, *x)) {
-        throw UsageError{spec.name + (list_item ? ": each" : "") + " must be a number in " + range_text(spec.range) +
-                         " (got '" + v + "')"};
+        throw UsageError{spec.name + (list_item ? ": each" : "") + " must be a number in " +
+                         range_text(spec.range) + " (got '" + v + "')"};
     }
     return *x;
 }
@@ -98,14 +102,15 @@ std::string resolution_default() {
     if (kDefaultResolutionRCullide == kDefaultResolutionQCullide) {
         return std::to_string(kDefaultResolutionRCullide) + " for rcullide and qcullide" + others;
     }
-    return std::to_string(kDefaultResolutionRCullide) + " for rcullide, " + std::to_string(kDefaultResolutionQCullide) +
-           " for qcullide" + others;
+    return std::to_string(kDefaultResolutionRCullide) + " for rcullide, " +
+           std::to_string(kDefaultResolutionQCullide) + " for qcullide" + others;
 }
 
 std::string min_prune_default() {
     char buf[32];
     const auto r = std::to_chars(buf, buf + sizeof buf, kDefaultMinPruneExactBounds);
-    return std::string(buf, r.ptr) + " for rcullide, 0 for cullide and rcullide-offset: stop when nothing more is pruned";
+    return std::string(buf, r.ptr) +
+           " for rcullide, 0 for cullide and rcullide-offset: stop when nothing more is pruned";
 }
 
 // Options every command reads the same way: the pipeline's knobs and the scene's seed and meshes.
@@ -118,81 +123,142 @@ void add_shared_options(std::vector<OptionSpec>& t) {
                  }});
     t.push_back({"--rounds", "N", kAllCommands, "rounds of x, y, z views per visibility stage",
                  integers(1, kMaxRounds), std::to_string(d.max_rounds), "",
-                 [](const OptionSpec& o, const std::string& v, Settings& s) { s.pipeline.max_rounds = int_value(o, v); }});
+                 [](const OptionSpec& o, const std::string& v, Settings& s) {
+                     s.pipeline.max_rounds = int_value(o, v);
+                 }});
     t.push_back({"--min-prune", "F", kAllCommands,
                  "a stage stops after three views in a row that each prune less than F of its live triangles",
                  reals(0, false, 1, true), min_prune_default(), "",
                  [](const OptionSpec& o, const std::string& v, Settings& s) {
                      s.pipeline.min_prune = real_value(o, v, false);
                  }});
-    t.push_back({"--object-stage", "S", kAllCommands,
-                 "the object-level triangle stage: auto (off for rcullide, whose sub-object views prune every object "
-                 "an object view would; on for cullide and rcullide-offset), on, off",
-                 {}, "auto", "",
-                 [](const OptionSpec& o, const std::string& v, Settings& s) {
-                     s.pipeline.object_stage = object_stage_value(o, v);
-                 }});
-    t.push_back({"--broadphase", "B", kAllCommands,
-                 "first stage on object boxes: none, spatialhash, sap, brute; objects overlapping no other box are "
-                 "dropped at once",
-                 {}, to_string(d.broadphase), "",
-                 [](const OptionSpec& o, const std::string& v, Settings& s) {
-                     s.pipeline.broadphase = checked(o, parse_broadphase(v));
-                 }});
-    t.push_back({"--self", "", kAllCommands,
-                 "also report pairs inside one object (adjacent triangles excluded); methods exact, qcullide, "
-                 "qcullide-gl (run: qcullide unless --method is given)",
-                 {}, "", "", [](const OptionSpec&, const std::string&, Settings& s) { s.pipeline.self = true; }});
-    t.push_back({"--seed", "S", kAllCommands, "scene seed, an unsigned 64-bit integer", {},
-                 std::to_string(SceneOptions{}.seed), "",
+    t.push_back(
+        {"--object-stage",
+         "S",
+         kAllCommands,
+         "the object-level triangle stage: auto (off for rcullide, whose sub-object views prune every object "
+         "an object view would; on for cullide and rcullide-offset), on, off",
+         {},
+         "auto",
+         "",
+         [](const OptionSpec& o, const std::string& v, Settings& s) {
+             s.pipeline.object_stage = object_stage_value(o, v);
+         }});
+    t.push_back(
+        {"--broadphase",
+         "B",
+         kAllCommands,
+         "first stage on object boxes: none, spatialhash, sap, brute; objects overlapping no other box are "
+         "dropped at once",
+         {},
+         to_string(d.broadphase),
+         "",
+         [](const OptionSpec& o, const std::string& v, Settings& s) {
+             s.pipeline.broadphase = checked(o, parse_broadphase(v));
+         }});
+    t.push_back(
+        {"--self",
+         "",
+         kAllCommands,
+         "also report pairs inside one object (adjacent triangles excluded); methods exact, qcullide, "
+         "qcullide-gl (run: qcullide unless --method is given)",
+         {},
+         "",
+         "",
+         [](const OptionSpec&, const std::string&, Settings& s) { s.pipeline.self = true; }});
+    t.push_back({"--seed",
+                 "S",
+                 kAllCommands,
+                 "scene seed, an unsigned 64-bit integer",
+                 {},
+                 std::to_string(SceneOptions{}.seed),
+                 "",
                  [](const OptionSpec& o, const std::string& v, Settings& s) {
                      const auto n = parse_integer<std::uint64_t>(v);
-                     if (!n) throw UsageError{o.name + " must be an unsigned 64-bit integer (got '" + v + "')"};
+                     if (!n)
+                         throw UsageError{o.name + " must be an unsigned 64-bit integer (got '" + v + "')"};
                      s.scene.seed = *n;
                  }});
-    t.push_back({"--mesh-dir", "DIR", kAllCommands, "where real meshes (bunny, dragon) are read from", {},
-                 SceneOptions{}.mesh_dir, "",
+    t.push_back({"--mesh-dir",
+                 "DIR",
+                 kAllCommands,
+                 "where real meshes (bunny, dragon) are read from",
+                 {},
+                 SceneOptions{}.mesh_dir,
+                 "",
                  [](const OptionSpec&, const std::string& v, Settings& s) { s.scene.mesh_dir = v; }});
 }
 
 void add_run_options(std::vector<OptionSpec>& t) {
     const RunOptions d;
-    t.push_back({"--method", "M", kRunOnly,
-                 "rcullide (R-CULLIDE, exact-bounds conservative raster: never misses), exact (the ground truth), "
-                 "cullide (GL-exact visibility culling, may miss collisions like the GPU original), rcullide-offset "
-                 "(R-CULLIDE with the paper's offset solids: never misses), qcullide (Quick-CULLIDE, exact-bounds: "
-                 "never misses), qcullide-gl (Quick-CULLIDE, GL-exact)",
-                 {}, std::string(to_string(d.method)) + "; qcullide with --self", "",
-                 [](const OptionSpec& o, const std::string& v, Settings& s) {
-                     s.pipeline.method = checked(o, parse_method(v));
-                     s.pipeline.method_given = true;
-                 }});
+    t.push_back(
+        {"--method",
+         "M",
+         kRunOnly,
+         "rcullide (R-CULLIDE, exact-bounds conservative raster: never misses), exact (the ground truth), "
+         "cullide (GL-exact visibility culling, may miss collisions like the GPU original), rcullide-offset "
+         "(R-CULLIDE with the paper's offset solids: never misses), qcullide (Quick-CULLIDE, exact-bounds: "
+         "never misses), qcullide-gl (Quick-CULLIDE, GL-exact)",
+         {},
+         std::string(to_string(d.method)) + "; qcullide with --self",
+         "",
+         [](const OptionSpec& o, const std::string& v, Settings& s) {
+             s.pipeline.method = checked(o, parse_method(v));
+             s.pipeline.method_given = true;
+         }});
     t.push_back({"--frames", "N", kRunOnly, "frames to run", integers(1, 1000000),
                  "10 for built-in scenes, 1 for files", "",
                  [](const OptionSpec& o, const std::string& v, Settings& s) { s.frames = int_value(o, v); }});
     t.push_back({"--threads", "T", kRunOnly, "worker threads, 0 = all cores; results do not depend on it",
                  integers(0, kMaxThreads), std::to_string(d.threads), "",
-                 [](const OptionSpec& o, const std::string& v, Settings& s) { s.pipeline.threads = int_value(o, v); }});
+                 [](const OptionSpec& o, const std::string& v, Settings& s) {
+                     s.pipeline.threads = int_value(o, v);
+                 }});
     t.push_back({"--resolution", "R", kRunOnly, "view resolution of visibility methods",
                  integers(kMinCliResolution, raster::kMaxTargetSize), resolution_default(), "",
-                 [](const OptionSpec& o, const std::string& v, Settings& s) { s.pipeline.resolution = int_value(o, v); }});
-    t.push_back({"--depth-format", "F", kRunOnly, "depth buffer of visibility methods: d16, d24, d32f", {},
-                 to_string(d.depth_format), "",
+                 [](const OptionSpec& o, const std::string& v, Settings& s) {
+                     s.pipeline.resolution = int_value(o, v);
+                 }});
+    t.push_back({"--depth-format",
+                 "F",
+                 kRunOnly,
+                 "depth buffer of visibility methods: d16, d24, d32f",
+                 {},
+                 to_string(d.depth_format),
+                 "",
                  [](const OptionSpec& o, const std::string& v, Settings& s) {
                      s.pipeline.depth_format = checked(o, parse_depth_format(v));
                  }});
-    t.push_back({"--scale", "X", kRunOnly, "scene size factor", reals(0, true, kMaxSceneScale, false),
-                 "1", "",
-                 [](const OptionSpec& o, const std::string& v, Settings& s) { s.scene.scale = real_value(o, v, false); }});
-    t.push_back({"--pairs", "FILE", kRunOnly,
-                 "write every colliding triangle pair as CSV: frame,object_a,triangle_a,object_b,triangle_b", {}, "",
-                 "", [](const OptionSpec&, const std::string& v, Settings& s) { s.pairs_file = v; }});
-    t.push_back({"--json", "", kRunOnly, "print the per-frame results as one JSON document instead of text", {}, "",
-                 "", [](const OptionSpec&, const std::string&, Settings& s) { s.json = true; }});
+    t.push_back({"--scale", "X", kRunOnly, "scene size factor", reals(0, true, kMaxSceneScale, false), "1",
+                 "", [](const OptionSpec& o, const std::string& v, Settings& s) {
+                     s.scene.scale = real_value(o, v, false);
+                 }});
+    t.push_back({"--pairs",
+                 "FILE",
+                 kRunOnly,
+                 "write every colliding triangle pair as CSV: frame,object_a,triangle_a,object_b,triangle_b",
+                 {},
+                 "",
+                 "",
+                 [](const OptionSpec&, const std::string& v, Settings& s) { s.pairs_file = v; }});
+    t.push_back({"--json",
+                 "",
+                 kRunOnly,
+                 "print the per-frame results as one JSON document instead of text",
+                 {},
+                 "",
+                 "",
+                 [](const OptionSpec&, const std::string&, Settings& s) { s.json = true; }});
 }
 
 void add_bench_options(std::vector<OptionSpec>& t) {
-    t.push_back({"--scenes", "LIST", kBenchSweep, "built-in scenes; 'all' = every scene", {}, "cylinders", "",
+    t.push_back({"--scenes",
+                 "LIST",
+                 kBenchSweep,
+                 "built-in scenes; 'all' = every scene",
+                 {},
+                 "cylinders",
+                 "",
                  [](const OptionSpec& o, const std::string& v, Settings& s) {
                      s.scenes.clear();  // a repeated option replaces the list
                      const std::vector<std::string> names = scene_names();
@@ -200,65 +266,112 @@ void add_bench_options(std::vector<OptionSpec>& t) {
                          if (item == "all") {
                              s.scenes.insert(s.scenes.end(), names.begin(), names.end());
                          } else if (std::find(names.begin(), names.end(), item) == names.end()) {
-                             throw UsageError{o.name + ": unknown scene '" + item + "' (valid: " + joined(names) +
-                                              ", all)"};
+                             throw UsageError{o.name + ": unknown scene '" + item +
+                                              "' (valid: " + joined(names) + ", all)"};
                          } else {
                              s.scenes.push_back(item);
                          }
                      }
-                 }, true});
-    t.push_back({"--scales", "LIST", kBenchSweep, "scene size factors", reals(0, true, kMaxSceneScale, false), "1",
-                 "", [](const OptionSpec& o, const std::string& v, Settings& s) {
+                 },
+                 true});
+    t.push_back({"--scales", "LIST", kBenchSweep, "scene size factors", reals(0, true, kMaxSceneScale, false),
+                 "1", "",
+                 [](const OptionSpec& o, const std::string& v, Settings& s) {
                      s.scales.clear();
-                     for (const std::string& item : list_items(o, v)) s.scales.push_back(real_value(o, item, true));
-                 }, true});
-    t.push_back({"--methods", "LIST", kBenchSweep, "methods (as run's --method); 'all' = every method", {},
-                 "exact,cullide,rcullide", "cullide,rcullide,rcullide-offset",
+                     for (const std::string& item : list_items(o, v))
+                         s.scales.push_back(real_value(o, item, true));
+                 },
+                 true});
+    t.push_back({"--methods",
+                 "LIST",
+                 kBenchSweep,
+                 "methods (as run's --method); 'all' = every method",
+                 {},
+                 "exact,cullide,rcullide",
+                 "cullide,rcullide,rcullide-offset",
                  [](const OptionSpec& o, const std::string& v, Settings& s) {
                      s.methods.clear();
                      for (const std::string& item : list_items(o, v)) {
                          if (item == "all") {
-                             for (const std::string& n : method_names()) s.methods.push_back(parse_method(n).value());
+                             for (const std::string& n : method_names())
+                                 s.methods.push_back(parse_method(n).value());
                          } else {
                              s.methods.push_back(checked(o, parse_method(item)));
                          }
                      }
-                 }, true});
+                 },
+                 true});
     t.push_back({"--resolutions", "LIST", kBenchSweep,
                  "view resolutions; bench without it runs each method at its own: " + resolution_default(),
                  integers(kMinCliResolution, raster::kMaxTargetSize), "", "32,64,128,256,512,1024",
                  [](const OptionSpec& o, const std::string& v, Settings& s) {
                      s.resolutions.clear();
-                     for (const std::string& item : list_items(o, v)) s.resolutions.push_back(int_value(o, item));
-                 }, true});
-    t.push_back({"--depth-formats", "LIST", kBenchSweep, "depth buffers: d16, d24, d32f", {},
-                 to_string(RunOptions{}.depth_format), "", [](const OptionSpec& o, const std::string& v, Settings& s) {
+                     for (const std::string& item : list_items(o, v))
+                         s.resolutions.push_back(int_value(o, item));
+                 },
+                 true});
+    t.push_back({"--depth-formats",
+                 "LIST",
+                 kBenchSweep,
+                 "depth buffers: d16, d24, d32f",
+                 {},
+                 to_string(RunOptions{}.depth_format),
+                 "",
+                 [](const OptionSpec& o, const std::string& v, Settings& s) {
                      s.depth_formats.clear();
                      for (const std::string& item : list_items(o, v)) {
                          s.depth_formats.push_back(checked(o, parse_depth_format(item)));
                      }
-                 }, true});
-    t.push_back({"--threads", "LIST", kBenchSweep, "worker threads, 0 = all cores", integers(0, kMaxThreads), "0",
-                 "", [](const OptionSpec& o, const std::string& v, Settings& s) {
+                 },
+                 true});
+    t.push_back({"--threads", "LIST", kBenchSweep, "worker threads, 0 = all cores", integers(0, kMaxThreads),
+                 "0", "",
+                 [](const OptionSpec& o, const std::string& v, Settings& s) {
                      s.thread_counts.clear();
-                     for (const std::string& item : list_items(o, v)) s.thread_counts.push_back(int_value(o, item));
-                 }, true});
+                     for (const std::string& item : list_items(o, v))
+                         s.thread_counts.push_back(int_value(o, item));
+                 },
+                 true});
     t.push_back({"--frames", "N", kBenchSweep, "frames per scene", integers(1, 100000), "5", "2",
-                 [](const OptionSpec& o, const std::string& v, Settings& s) { s.frames = int_value(o, v); }, true});
-    t.push_back({"--first-frame", "F", kBenchSweep, "first frame index", integers(-1000000, 1000000), "0", "",
-                 [](const OptionSpec& o, const std::string& v, Settings& s) { s.first_frame = int_value(o, v); }, true});
-    t.push_back({"--frame-step", "K", kBenchSweep, "frame index step", integers(1, 100000), "1", "",
-                 [](const OptionSpec& o, const std::string& v, Settings& s) { s.frame_step = int_value(o, v); }, true});
+                 [](const OptionSpec& o, const std::string& v, Settings& s) { s.frames = int_value(o, v); },
+                 true});
+    t.push_back(
+        {"--first-frame", "F", kBenchSweep, "first frame index", integers(-1000000, 1000000), "0", "",
+         [](const OptionSpec& o, const std::string& v, Settings& s) { s.first_frame = int_value(o, v); },
+         true});
+    t.push_back(
+        {"--frame-step", "K", kBenchSweep, "frame index step", integers(1, 100000), "1", "",
+         [](const OptionSpec& o, const std::string& v, Settings& s) { s.frame_step = int_value(o, v); },
+         true});
     t.push_back({"--warmup", "N", kBenchSweep, "untimed runs per frame", integers(0, 1000), "1", "0",
-                 [](const OptionSpec& o, const std::string& v, Settings& s) { s.warmup = int_value(o, v); }, true});
+                 [](const OptionSpec& o, const std::string& v, Settings& s) { s.warmup = int_value(o, v); },
+                 true});
     t.push_back({"--reps", "N", kBenchSweep, "timed runs per frame", integers(1, 1000), "5", "1",
-                 [](const OptionSpec& o, const std::string& v, Settings& s) { s.reps = int_value(o, v); }, true});
-    t.push_back({"--csv", "FILE", kBenchSweep, "write one CSV row per combination ('-' = stdout)", {}, "", "",
+                 [](const OptionSpec& o, const std::string& v, Settings& s) { s.reps = int_value(o, v); },
+                 true});
+    t.push_back({"--csv",
+                 "FILE",
+                 kBenchSweep,
+                 "write one CSV row per combination ('-' = stdout)",
+                 {},
+                 "",
+                 "",
                  [](const OptionSpec&, const std::string& v, Settings& s) { s.csv_path = v; }});
-    t.push_back({"--json", "FILE", kBenchSweep, "write a JSON document ('-' = stdout)", {}, "", "",
+    t.push_back({"--json",
+                 "FILE",
+                 kBenchSweep,
+                 "write a JSON document ('-' = stdout)",
+                 {},
+                 "",
+                 "",
                  [](const OptionSpec&, const std::string& v, Settings& s) { s.json_path = v; }});
-    t.push_back({"--no-progress", "", kBenchSweep,
-                 "no progress bar (it is drawn on stderr only when stderr is a terminal)", {}, "", "",
+    t.push_back({"--no-progress",
+                 "",
+                 kBenchSweep,
+                 "no progress bar (it is drawn on stderr only when stderr is a terminal)",
+                 {},
+                 "",
+                 "",
                  [](const OptionSpec&, const std::string&, Settings& s) { s.progress = false; }});
 }
 
@@ -284,9 +397,12 @@ std::string refusal(const std::string& name, Command command) {
 
 const char* command_name(Command c) {
     switch (c) {
-        case Command::Run: return "run";
-        case Command::Bench: return "bench";
-        case Command::Sweep: return "sweep";
+        case Command::Run:
+            return "run";
+        case Command::Bench:
+            return "bench";
+        case Command::Sweep:
+            return "sweep";
     }
     return "?";
 }
@@ -330,9 +446,11 @@ std::string range_text(const Range& r) {
         return std::string(buf, res.ptr);
     };
     switch (r.kind) {
-        case Range::Kind::None: return "";
+        case Range::Kind::None:
+            return "";
         case Range::Kind::Integer:  // digits, never 1e+06
-            return std::to_string(static_cast<long long>(r.lo)) + ".." + std::to_string(static_cast<long long>(r.hi));
+            return std::to_string(static_cast<long long>(r.lo)) + ".." +
+                   std::to_string(static_cast<long long>(r.hi));
         case Range::Kind::Real:
             return (r.lo_open ? "(" : "[") + number(r.lo) + ", " + number(r.hi) + (r.hi_open ? ")" : "]");
     }
@@ -359,8 +477,9 @@ Settings parse_options(Command command, const std::vector<std::string>& args) {
             }
             throw UsageError{"unknown option '" + a + "' (scenes are given with --scenes)"};
         }
-        const auto spec = std::find_if(table.begin(), table.end(),
-                                       [&](const OptionSpec& o) { return o.name == a && takes(o.commands, command); });
+        const auto spec = std::find_if(table.begin(), table.end(), [&](const OptionSpec& o) {
+            return o.name == a && takes(o.commands, command);
+        });
         if (spec == table.end()) throw UsageError{refusal(a, command)};
         std::string value;
         if (!spec->value.empty()) {
@@ -373,7 +492,8 @@ Settings parse_options(Command command, const std::vector<std::string>& args) {
     for (const OptionSpec& o : table) {
         if (!o.default_is_value || !takes(o.commands, command)) continue;
         if (std::find(given.begin(), given.end(), &o) != given.end()) continue;
-        const std::string& d = command == Command::Sweep && !o.sweep_default.empty() ? o.sweep_default : o.default_text;
+        const std::string& d =
+            command == Command::Sweep && !o.sweep_default.empty() ? o.sweep_default : o.default_text;
         if (!d.empty()) o.apply(o, d, s);
     }
     return s;

@@ -19,7 +19,8 @@ namespace cullide::cli {
 enum class Command : unsigned { Run = 1u, Bench = 2u, Sweep = 4u };
 using CommandSet = unsigned;
 inline constexpr CommandSet kRunOnly = static_cast<unsigned>(Command::Run);
-inline constexpr CommandSet kBenchSweep = static_cast<unsigned>(Command::Bench) | static_cast<unsigned>(Command::Sweep);
+inline constexpr CommandSet kBenchSweep =
+    static_cast<unsigned>(Command::Bench) | static_cast<unsigned>(Command::Sweep);
 inline constexpr CommandSet kAllCommands = kRunOnly | kBenchSweep;
 
 [[nodiscard]] inline bool takes(CommandSet set, Command c) { return (set & static_cast<unsigned>(c)) != 0; }
@@ -92,7 +93,7 @@ struct OptionSpec {
     std::string name;   // "--resolution"
     std::string value;  // placeholder in help ("R", "LIST"); empty for a flag, which takes no value
     CommandSet commands = 0;
-    std::string help;   // what it does; range and default are appended by the help generator
+    std::string help;  // what it does; range and default are appended by the help generator
     Range range;
     std::string default_text;   // empty: no default worth printing
     std::string sweep_default;  // sweep's default where it differs from bench's; else empty

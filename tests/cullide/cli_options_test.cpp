@@ -43,7 +43,8 @@ const std::vector<Command> kCommands{Command::Run, Command::Bench, Command::Swee
 
 }  // namespace
 
-TEST_CASE("every option of the table is in cullide help, in each taking command's --help and in the man page") {
+TEST_CASE(
+    "every option of the table is in cullide help, in each taking command's --help and in the man page") {
     const Outcome help = run({"help"});
     REQUIRE(help.status == 0);
     const Outcome man = run({"help", "--man"});
@@ -112,14 +113,15 @@ TEST_CASE("--version and version print the version of CMake's project() and the 
 
 TEST_CASE("the ranges printed and checked are the library's limits") {
     const std::string run_help = one_line(run({"run", "--help"}).out);
-    CHECK(has(run_help, "view resolution of visibility methods (16.." + std::to_string(raster::kMaxTargetSize)));
+    CHECK(has(run_help,
+              "view resolution of visibility methods (16.." + std::to_string(raster::kMaxTargetSize)));
     CHECK(has(run_help, "(1.." + std::to_string(cullide::kMaxRounds) + "; default 4)"));
     CHECK(has(run_help, "scene size factor ((0, 100]; default 1)"));
     CHECK(cullide::kMaxSceneScale == 100.0);
     const std::string too_big = std::to_string(raster::kMaxTargetSize + 1);
-    CHECK(has(run({"run", "--resolution", too_big}).err,
-              "--resolution must be an integer in 16.." + std::to_string(raster::kMaxTargetSize) + " (got '" +
-                  too_big + "')"));
+    CHECK(has(run({"run", "--resolution", too_big}).err, "--resolution must be an integer in 16.." +
+                                                             std::to_string(raster::kMaxTargetSize) +
+                                                             " (got '" + too_big + "')"));
     CHECK(has(run({"sweep", "--rounds", "1001"}).err, "--rounds must be an integer in 1..1000 (got '1001')"));
 }
 
@@ -154,8 +156,8 @@ TEST_CASE("the man page is man(7) roff: a title, the sections, and no line a for
     std::string line;
     while (std::getline(lines, line)) {
         CAPTURE(line);
-        CHECK_FALSE(line.empty());              // a blank line is a paragraph break in roff
-        CHECK(line.rfind("'", 0) != 0);         // a control line with the other control character
+        CHECK_FALSE(line.empty());                    // a blank line is a paragraph break in roff
+        CHECK(line.rfind("'", 0) != 0);               // a control line with the other control character
         CHECK(line.find("--") == std::string::npos);  // hyphens are escaped as \-
     }
 }
