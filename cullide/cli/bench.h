@@ -6,8 +6,8 @@
 //   bench  warm-up runs, timed repetitions, median and spread; a method that never misses
 //          (exact, rcullide*, qcullide) whose pairs differ from the ground truth is an error and no time is
 //          reported for it (exit 1); methods that may miss (cullide) are reported with their misses.
-//   sweep  the grid resolution x depth format (defaults 32..1024, d16/d24/d32f) for the visibility
-//          methods, one timed run per frame, with PCS sizes per stage, false negatives and false
+//   sweep  the grid resolution x depth format for the visibility methods (defaults: the option
+//          table, cli/options.cpp; `cullide sweep --help` prints them), one timed run per frame, with PCS sizes per stage, false negatives and false
 //          positives; a never-miss method that misses is recorded as MISMATCH and the exit status is 1.
 // In both, a method whose repeated runs of one frame give different pairs (nondeterminism) or that
 // reports a pair the exact test rejects is an error.

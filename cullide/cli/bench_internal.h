@@ -1,5 +1,5 @@
 // cullide/cli/bench_internal.h: pieces shared by bench.cpp (the engine, output) and sweep.cpp (the
-// sweep's defaults and the comparison with the ground truth). Not installed, not a public API.
+// comparison with the ground truth). Not installed, not a public API.
 #pragma once
 
 #include <cstdint>
@@ -11,14 +11,11 @@
 #include "cullide/ground_truth.h"
 #include "cullide/pipeline.h"
 #include "cullide/scenes.h"
+#include "options.h"
 
 namespace cullide::cli::bench_detail {
 
-struct BenchUsageError {
-    std::string message;
-};
-
-// Options of bench and sweep; lists are cross-multiplied.
+// Options of bench and sweep (defaults filled in by the option table); lists are cross-multiplied.
 struct BenchArgs {
     bool sweep = false;
     std::vector<std::string> scenes;
@@ -32,15 +29,11 @@ struct BenchArgs {
     int frame_step = 1;
     int warmup = 0;
     int reps = 0;
-    RunOptions base;  // subobject, rounds, broadphase, self
+    PipelineSettings base;  // subobject, rounds, min-prune, object stage, broadphase, self
     SceneOptions scene_options;
     std::string csv_path, json_path;
     bool progress = true;
 };
-
-// Defaults of one command (sweep.cpp holds the sweep's, bench.cpp the bench's).
-void apply_sweep_defaults(BenchArgs& a);
-extern const char* const kSweepUsage;
 
 // A method's pairs against the ground truth of one frame (both sorted and unique).
 struct Comparison {

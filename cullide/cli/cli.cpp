@@ -1,7 +1,5 @@
 #include "cli.h"
 
-#include <charconv>
-#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iomanip>
@@ -14,73 +12,14 @@
 #include <vector>
 
 #include "bench.h"
+#include "help.h"
+#include "options.h"
 #include "cullide/mesh_io.h"
 #include "cullide/pipeline.h"
 #include "cullide/scenes.h"
 
 namespace cullide::cli {
 namespace {
-
-constexpr const char* kUsage =
-    "usage: cullide <command> [options]\n"
-    "\n"
-    "commands:\n"
-    "  run [SCENE...]   detect colliding triangle pairs, frame by frame\n"
-    "  scenes           list the built-in scenes\n"
-    "  bench            time methods per frame, checked against the ground truth (bench --help)\n"
-    "  sweep            resolution x depth format x method x scene: time, PCS, errors (sweep --help)\n"
-    "  help             this text\n"
-    "\n"
-    "SCENE is one built-in scene name (default: cylinders) or mesh files (.obj .ply .stl); each file is\n"
-    "one object, or one object per OBJ group, in argument order.\n"
-    "\n"
-    "run options:\n"
-    "  --method M        rcullide (default; R-CULLIDE, exact-bounds conservative raster: never\n"
-    "                    misses), exact (the ground truth), cullide (GL-exact visibility culling, may\n"
-    "                    miss collisions like the GPU original), rcullide-offset (R-CULLIDE with the\n"
-    "                    paper's offset solids: never misses), qcullide (Quick-CULLIDE, exact-bounds:\n"
-    "                    never misses; the default with --self), qcullide-gl (Quick-CULLIDE, GL-exact)\n"
-    "  --frames N        frames to run (default 10 for built-in scenes, 1 for files; 1..1000000)\n"
-    "  --threads T       worker threads, 0 = all cores (default 0); results do not depend on it\n"
-    "  --resolution R    view resolution of visibility methods, 16..16384 (default 32 for rcullide\n"
-    "                    and qcullide, 1024 for the others)\n"
-    "  --depth-format F  depth buffer of visibility methods: d16, d24 (default), d32f\n"
-    "  --subobject N     triangles per sub-object of visibility methods, 1..65536 (default 4)\n"
-    "  --rounds N        rounds of x, y, z views per visibility stage, 1..1000 (default 4)\n"
-    "  --min-prune F     a stage stops after three views in a row that each prune less than F of\n"
-    "                    its live triangles, 0 <= F < 1 (default 0.5 for rcullide, 0 for cullide and\n"
-    "                    rcullide-offset: stop when nothing more is pruned)\n"
-    "  --object-stage S  auto (default: off for rcullide, whose sub-object views prune every object\n"
-    "                    an object view would; on for cullide and rcullide-offset), on, off\n"
-    "  --broadphase B    first stage on object boxes: none (default), spatialhash, sap, brute;\n"
-    "                    objects overlapping no other box are dropped at once\n"
-    "  --self            also report pairs inside one object (adjacent triangles excluded); methods\n"
-    "                    exact, qcullide, qcullide-gl\n"
-    "  --pairs FILE      write every colliding triangle pair as CSV:\n"
-    "                    frame,object_a,triangle_a,object_b,triangle_b\n"
-    "  --json            print the per-frame results as one JSON document instead of text\n"
-    "  --seed S          scene seed, an unsigned 64-bit integer (default 1)\n"
-    "  --scale X         scene size factor, 0 < X <= 100 (default 1)\n"
-    "  --mesh-dir DIR    where real meshes are read from (default ../shared/data/meshes)\n";
-
-struct UsageError {
-    std::string message;
-};
-
-template <class T>
-std::optional<T> parse_integer(std::string_view s) {
-    T v{};
-    auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (ec != std::errc() || ptr != s.data() + s.size() || s.empty()) return std::nullopt;
-    return v;
-}
-
-std::optional<double> parse_double(std::string_view s) {
-    double v = 0;
-    auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (ec != std::errc() || ptr != s.data() + s.size() || s.empty() || !std::isfinite(v)) return std::nullopt;
-    return v;
-}
 
 std::string json_escape(const std::string& s) {
     std::string o;
@@ -102,102 +41,19 @@ std::string json_escape(const std::string& s) {
 struct RunArgs {
     std::vector<std::string> scene;
     RunOptions options;
-    bool method_given = false;  // --self without --method runs qcullide
-    bool resolution_given = false;  // else the method's default_resolution
     std::optional<int> frames;
     std::string pairs_file;
     bool json = false;
     SceneOptions scene_options;
 };
 
-RunArgs parse_run_args(const std::vector<std::string>& args) {
-    RunArgs r;
-    auto need_value = [&](std::size_t& i) -> const std::string& {
-        if (i + 1 >= args.size()) throw UsageError{"option " + args[i] + " needs a value"};
-        return args[++i];
-    };
-    for (std::size_t i = 1; i < args.size(); ++i) {
-        const std::string& a = args[i];
-        if (a == "--method") {
-            const std::string& v = need_value(i);
-            Result<Method> m = parse_method(v);
-            if (!m) throw UsageError{m.error().message};
-            r.options.method = m.value();
-            r.method_given = true;
-        } else if (a == "--frames") {
-            const std::string& v = need_value(i);
-            auto n = parse_integer<int>(v);
-            if (!n || *n < 1 || *n > 1000000) throw UsageError{"--frames must be an integer in 1..1000000 (got '" + v + "')"};
-            r.frames = *n;
-        } else if (a == "--threads") {
-            const std::string& v = need_value(i);
-            auto n = parse_integer<int>(v);
-            if (!n || *n < 0 || *n > 1024) throw UsageError{"--threads must be an integer in 0..1024 (got '" + v + "')"};
-            r.options.threads = *n;
-        } else if (a == "--resolution") {
-            const std::string& v = need_value(i);
-            auto n = parse_integer<int>(v);
-            if (!n || *n < 16 || *n > 16384) {
-                throw UsageError{"--resolution must be an integer in 16..16384 (got '" + v + "')"};
-            }
-            r.options.resolution = *n;
-            r.resolution_given = true;
-        } else if (a == "--depth-format") {
-            Result<raster::DepthFormat> f = parse_depth_format(need_value(i));
-            if (!f) throw UsageError{"--depth-format: " + f.error().message};
-            r.options.depth_format = f.value();
-        } else if (a == "--broadphase") {
-            Result<BroadPhase> b = parse_broadphase(need_value(i));
-            if (!b) throw UsageError{"--broadphase: " + b.error().message};
-            r.options.broadphase = b.value();
-        } else if (a == "--subobject") {
-            const std::string& v = need_value(i);
-            auto n = parse_integer<int>(v);
-            if (!n || *n < 1 || *n > 65536) throw UsageError{"--subobject must be an integer in 1..65536 (got '" + v + "')"};
-            r.options.subobject_triangles = *n;
-        } else if (a == "--rounds") {
-            const std::string& v = need_value(i);
-            auto n = parse_integer<int>(v);
-            if (!n || *n < 1 || *n > 1000) throw UsageError{"--rounds must be an integer in 1..1000 (got '" + v + "')"};
-            r.options.max_rounds = *n;
-        } else if (a == "--min-prune") {
-            const std::string& v = need_value(i);
-            auto x = parse_double(v);
-            if (!x || !(*x >= 0) || !(*x < 1)) throw UsageError{"--min-prune must be a number in [0, 1) (got '" + v + "')"};
-            r.options.min_prune = *x;
-        } else if (a == "--object-stage") {
-            const std::string& v = need_value(i);
-            if (v == "auto") r.options.object_stage = ObjectStage::Auto;
-            else if (v == "on") r.options.object_stage = ObjectStage::On;
-            else if (v == "off") r.options.object_stage = ObjectStage::Off;
-            else throw UsageError{"--object-stage must be auto, on or off (got '" + v + "')"};
-        } else if (a == "--self") {
-            r.options.self = true;
-        } else if (a == "--pairs") {
-            r.pairs_file = need_value(i);
-        } else if (a == "--json") {
-            r.json = true;
-        } else if (a == "--seed") {
-            const std::string& v = need_value(i);
-            auto n = parse_integer<std::uint64_t>(v);
-            if (!n) throw UsageError{"--seed must be an unsigned 64-bit integer (got '" + v + "')"};
-            r.scene_options.seed = *n;
-        } else if (a == "--scale") {
-            const std::string& v = need_value(i);
-            auto x = parse_double(v);
-            if (!x || !(*x > 0) || *x > 100) throw UsageError{"--scale must be a number in (0, 100] (got '" + v + "')"};
-            r.scene_options.scale = *x;
-        } else if (a == "--mesh-dir") {
-            r.scene_options.mesh_dir = need_value(i);
-        } else if (a.size() > 1 && a[0] == '-') {
-            throw UsageError{"unknown option '" + a + "'"};
-        } else {
-            r.scene.push_back(a);
-        }
-    }
-    if (r.options.self && !r.method_given) r.options.method = Method::QCullide;
-    if (!r.resolution_given) r.options.resolution = default_resolution(r.options.method);
-    return r;
+// run's own defaults, after the table's: --self without --method runs qcullide, and a method without
+// --resolution runs at its default_resolution (printed, so the text and JSON show the real figure).
+RunArgs run_args_of(const Settings& s) {
+    PipelineSettings p = s.pipeline;
+    if (p.self && !p.method_given) p.method = Method::QCullide;
+    if (p.resolution == 0) p.resolution = default_resolution(p.method);
+    return RunArgs{s.inputs, to_run_options(p), s.frames, s.pairs_file, s.json, s.scene};
 }
 
 bool is_builtin(const std::string& name) {
@@ -208,7 +64,12 @@ bool is_builtin(const std::string& name) {
 }
 
 int run_command(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
-    RunArgs r = parse_run_args(args);
+    const Settings settings = parse_options(Command::Run, args);
+    if (settings.help) {
+        out << command_help(Command::Run);
+        return 0;
+    }
+    RunArgs r = run_args_of(settings);
     if (r.scene.empty()) r.scene.push_back("cylinders");
 
     // The frame source: a built-in generator, or the objects of the given files (static).
@@ -349,25 +210,65 @@ int run_command(const std::vector<std::string>& args, std::ostream& out, std::os
     return 0;
 }
 
+// `cullide help [COMMAND] [--man]`.
+int help_command(const std::vector<std::string>& args, std::ostream& out) {
+    if (args.size() == 1) {
+        out << usage_text();
+        return 0;
+    }
+    if (args.size() == 2 && args[1] == "--man") {
+        out << man_page();
+        return 0;
+    }
+    if (args.size() == 2) {
+        for (Command c : {Command::Run, Command::Bench, Command::Sweep}) {
+            if (args[1] == command_name(c)) {
+                out << command_help(c);
+                return 0;
+            }
+        }
+    }
+    throw UsageError{"help takes one command name (run, bench, sweep) or --man (got '" + args[1] + "')"};
+}
+
+int scenes_command(const std::vector<std::string>& args, std::ostream& out) {
+    if (args.size() > 1) throw UsageError{"scenes takes no options or operands (got '" + args[1] + "')"};
+    SceneOptions defaults;
+    for (const std::string& name : scene_names()) {
+        Result<std::unique_ptr<SceneGenerator>> g = make_scene(name, defaults);
+        out << name << ": " << (g ? g.value()->description() : g.error().message) << "\n";
+    }
+    return 0;
+}
+
+int version_command(const std::vector<std::string>& args, std::ostream& out) {
+    if (args.size() > 1) throw UsageError{"version takes no options (got '" + args[1] + "')"};
+    out << version_text();
+    return 0;
+}
+
 }  // namespace
 
 int run(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+    if (args.empty()) {
+        err << usage_text();
+        return 2;
+    }
+    const std::string& command = args[0];
     try {
-        if (args.empty() || args[0] == "help" || args[0] == "--help" || args[0] == "-h") {
-            (args.empty() ? err : out) << kUsage;
-            return args.empty() ? 2 : 0;
-        }
-        if (args[0] == "scenes") {
-            SceneOptions defaults;
-            for (const std::string& name : scene_names()) {
-                Result<std::unique_ptr<SceneGenerator>> g = make_scene(name, defaults);
-                out << name << ": " << (g ? g.value()->description() : g.error().message) << "\n";
+        if (command == "help" || command == "--help" || command == "-h") return help_command(args, out);
+        if (command == "version" || command == "--version") return version_command(args, out);
+        if (command == "scenes") return scenes_command(args, out);
+        if (command == "bench" || command == "sweep") return bench_command(args, out, err);
+        if (command == "run") {
+            try {
+                return run_command(args, out, err);
+            } catch (const UsageError& e) {
+                err << "cullide run: " << e.message << "\n(run 'cullide run --help' for usage)\n";
+                return 2;
             }
-            return 0;
         }
-        if (args[0] == "run") return run_command(args, out, err);
-        if (args[0] == "bench" || args[0] == "sweep") return bench_command(args, out, err);
-        throw UsageError{"unknown command '" + args[0] + "'"};
+        throw UsageError{"unknown command '" + command + "'"};
     } catch (const UsageError& e) {
         err << "cullide: " << e.message << "\n(run 'cullide help' for usage)\n";
         return 2;

@@ -628,8 +628,9 @@ Status check_visibility_inputs(std::span<const Mesh> objects, std::span<const st
                      std::to_string(resolution) + ")"};
     if (subobject_triangles < 1)
         return Error{"sub-object size must be >= 1 triangle (got " + std::to_string(subobject_triangles) + ")"};
-    if (max_rounds < 1 || max_rounds > 1000)
-        return Error{"max_rounds must be in 1..1000 (got " + std::to_string(max_rounds) + ")"};
+    if (max_rounds < 1 || max_rounds > kMaxRounds)
+        return Error{"max_rounds must be in 1.." + std::to_string(kMaxRounds) + " (got " + std::to_string(max_rounds) +
+                     ")"};
     if (threads < 0) return Error{"threads must be >= 0 (got " + std::to_string(threads) + ")"};
     if (Status s = validate_scene(objects); !s) return s;
     if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};

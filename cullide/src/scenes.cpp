@@ -13,8 +13,6 @@ namespace cullide {
 
 namespace {
 
-constexpr double kMaxScale = 100.0;
-
 std::string format_double(double v) {
     char buf[64];
     const std::to_chars_result r = std::to_chars(buf, buf + sizeof(buf), v);
@@ -32,7 +30,7 @@ std::string joined_names() {
 std::vector<std::string> scene_names() { return {"cylinders", "tori", "bunny-dragon", "breaking", "leaves", "cloth"}; }
 
 Result<std::unique_ptr<SceneGenerator>> make_scene(const std::string& name, const SceneOptions& options) {
-    if (!(std::isfinite(options.scale) && options.scale > 0.0 && options.scale <= kMaxScale)) {
+    if (!(std::isfinite(options.scale) && options.scale > 0.0 && options.scale <= kMaxSceneScale)) {
         return Error{"scene option scale = " + format_double(options.scale) +
                      " is out of range: it must be finite, > 0 and <= 100"};
     }

@@ -1,6 +1,8 @@
 // pipeline.cpp: llvmpipe's triangle front end and the per-rectangle back end. See pipeline.h.
 #include "pipeline.h"
 
+#include "raster/command_batch.h"
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -263,3 +265,9 @@ std::uint64_t raster_rect(const SetupTri& tri, DepthFormat format, DepthFunc fun
 }
 
 }  // namespace raster::detail
+
+namespace raster {
+
+bool simd_kernel_active() { return detail::kernel_avx2_available() && detail::simd_allowed_by_environment(); }
+
+}  // namespace raster

@@ -87,12 +87,15 @@ struct ViewStats {
     std::uint64_t triangles_rasterized = 0;  // triangles submitted in draws (queries and writes)
 };
 
+// The most rounds of x, y, z views per stage a caller may ask for (max_rounds).
+inline constexpr int kMaxRounds = 1000;
+
 struct CullideOptions {
     VisibilityMode mode = VisibilityMode::GLExact;
     int resolution = 1024;  // pixels per side of every view, 16..16384
     raster::DepthFormat depth_format = raster::DepthFormat::D24;
     int subobject_triangles = 4;  // triangles per sub-object, >= 1
-    int max_rounds = 4;           // rounds of three views per stage, >= 1
+    int max_rounds = 4;           // rounds of three views per stage, 1..kMaxRounds
     // A view counts as unproductive when the triangles of the items it prunes are fewer than this
     // fraction of the stage's live triangles before it; a stage stops after three unproductive
     // views in a row (one per axis). 0: stop only when three views in a row prune nothing (the

@@ -15,6 +15,9 @@
 
 namespace cullide {
 
+// The largest SceneOptions::scale.
+inline constexpr double kMaxSceneScale = 100.0;
+
 struct SceneOptions {
     std::uint64_t seed = 1;
     // Where real meshes are looked for (bunny/dragon pair). Empty: procedural stand-ins only.
@@ -23,7 +26,7 @@ struct SceneOptions {
     // What it multiplies differs per scene (docs/scenes.md): the cylinder count; the triangles per
     // torus / bunny / dragon / shell / ball / cloth; the falling and attached leaf counts. Counts are
     // rounded to the nearest integer with a small floor, so 0.05 gives tiny scenes. Must be finite,
-    // > 0 and <= 100.
+    // > 0 and <= kMaxSceneScale.
     double scale = 1.0;
 };
 

@@ -59,6 +59,11 @@ struct ExecuteOptions {
     bool allow_simd = true;  // false: always the portable kernel (tests compare the two)
 };
 
+// True when allow_simd runs the GL-exact AVX2 kernel in this process: it was built (x86-64, GCC or
+// Clang), the CPU has AVX2 and FMA, and CULLIDE_RASTER_NO_SIMD is unset or 0. For reports such as
+// `cullide --version`; results never depend on it (the kernels are bit-identical).
+[[nodiscard]] bool simd_kernel_active();
+
 // Query results, indexed like begin_query() returned: samples passed for SamplesPassed queries,
 // 0 or 1 for AnySamplesPassed.
 using QueryResults = std::vector<std::uint64_t>;
