@@ -1,7 +1,16 @@
-# Dependency lookup. Each result is a CULLIDE_HAVE_* variable; nothing here is required except
-# Eigen (scene generators). The libraries build with none of TBB, OSMesa and Embree.
+# Dependency lookup. Each result is a CULLIDE_HAVE_* variable; nothing here is required. The libraries
+# build with none of TBB, OSMesa, Embree and Eigen.
 
-find_package(Eigen3 3.4 REQUIRED NO_MODULE)
+# Eigen: only the header-only front door cullide/eigen.h (target cullide::eigen) and its tests use it.
+set(CULLIDE_HAVE_EIGEN OFF)
+if(CULLIDE_WITH_EIGEN)
+  find_package(Eigen3 3.4 QUIET NO_MODULE)
+  if(Eigen3_FOUND)
+    set(CULLIDE_HAVE_EIGEN ON)
+  else()
+    message(STATUS "cullide: Eigen 3.4 not found, the Eigen front door (cullide::eigen) is not built")
+  endif()
+endif()
 
 set(CULLIDE_HAVE_TBB OFF)
 if(CULLIDE_WITH_TBB)
