@@ -14,7 +14,6 @@
 
 option(CULLIDE_STRICT_DEPS "Fail when a package switched on by CULLIDE_WITH_* is not found" OFF)
 option(CULLIDE_WITH_GMP "Use GMP for the rational references of tests and fuzzers" ON)
-option(CULLIDE_WITH_EIGEN "Build the Eigen front door (cullide/eigen.h) and its tests" ON)
 option(CULLIDE_WITH_FCL "Compare against FCL in the benchmarks" ON)
 option(CULLIDE_WITH_BULLET "Compare against Bullet in the benchmarks" ON)
 option(CULLIDE_WITH_CGAL "Compare against CGAL in the benchmarks" ON)

@@ -75,6 +75,7 @@ int run_command(const std::vector<std::string>& args, std::ostream& out, std::os
     // The frame source: a built-in generator, or the objects of the given files (static).
     std::unique_ptr<SceneGenerator> generator;
     std::vector<Mesh> file_objects;
+    std::vector<MeshReadInfo> file_infos;  // one per file argument: what its reader skipped (--json)
     std::string scene_label;
     if (r.scene.size() == 1 && is_builtin(r.scene[0])) {
         Result<std::unique_ptr<SceneGenerator>> g = make_scene(r.scene[0], r.scene_options);
@@ -87,11 +88,13 @@ int run_command(const std::vector<std::string>& args, std::ostream& out, std::os
     } else {
         for (const std::string& path : r.scene) {
             if (is_builtin(path)) throw UsageError{"give one built-in scene or mesh files, not both ('" + path + "')"};
-            Result<std::vector<Mesh>> meshes = read_mesh_file(path);
+            MeshReadInfo info;
+            Result<std::vector<Mesh>> meshes = read_mesh_file(path, &info);
             if (!meshes) {
                 err << "cullide: error: " << meshes.error().message << "\n";
                 return 1;
             }
+            file_infos.push_back(info);
             for (Mesh& m : meshes.value()) file_objects.push_back(std::move(m));
             scene_label += (scene_label.empty() ? "" : " ") + path;
         }
@@ -114,7 +117,18 @@ int run_command(const std::vector<std::string>& args, std::ostream& out, std::os
             << "\", \"self\": " << (r.options.self ? "true" : "false") << ", \"resolution\": "
             << r.options.resolution << ", \"depth_format\": \"" << to_string(r.options.depth_format)
             << "\", \"subobject\": " << r.options.subobject_triangles << ", \"rounds\": " << r.options.max_rounds
-            << ", \"broadphase\": \"" << to_string(r.options.broadphase) << "\", \"frames\": [";
+            << ", \"broadphase\": \"" << to_string(r.options.broadphase) << "\", \"inputs\": [";
+        // Per mesh file (none for a built-in scene): the statements its reader read and dropped.
+        for (std::size_t i = 0; i < file_infos.size(); ++i) {
+            out << (i ? ", " : "") << "{\"file\": \"" << json_escape(r.scene[i]) << "\", \"skipped\": {";
+            bool first_key = true;
+            for (const auto& [keyword, count] : file_infos[i].skipped()) {
+                out << (first_key ? "" : ", ") << '"' << keyword << "\": " << count;
+                first_key = false;
+            }
+            out << "}}";
+        }
+        out << "], \"frames\": [";
     } else {
         out << "cullide run: scene " << scene_label << ", method " << to_string(r.options.method)
             << (r.options.self ? ", self-collision on" : "");

@@ -35,8 +35,23 @@ Aabb mesh_bounds(const Mesh& mesh) {
     return box;
 }
 
+namespace {
+std::string mesh_label(const Mesh& mesh) { return "mesh '" + mesh.name + "'"; }
+}  // namespace
+
+Error vertex_index_error(const Mesh& mesh, std::size_t triangle, std::uint64_t index) {
+    return Error{mesh_label(mesh) + ": triangle " + std::to_string(triangle) + " vertex index " + std::to_string(index) +
+                 " is beyond the vertex list (size " + std::to_string(mesh.positions.size()) + ")"};
+}
+
+Error vertex_index_error(const Mesh& mesh, std::size_t triangle, std::int64_t index) {
+    if (index >= 0) return vertex_index_error(mesh, triangle, static_cast<std::uint64_t>(index));
+    return Error{mesh_label(mesh) + ": triangle " + std::to_string(triangle) + " vertex index " + std::to_string(index) +
+                 " is negative (the vertex list has size " + std::to_string(mesh.positions.size()) + ")"};
+}
+
 Status validate_mesh(const Mesh& mesh) {
-    const std::string who = "mesh '" + mesh.name + "'";
+    const std::string who = mesh_label(mesh);
     if (mesh.triangles.empty()) return Error{who + ": has no triangles"};
     for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
         const Vec3& p = mesh.positions[i];
@@ -47,10 +62,7 @@ Status validate_mesh(const Mesh& mesh) {
     for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
         for (int k = 0; k < 3; ++k) {
             const std::uint32_t v = mesh.triangles[i][k];
-            if (v >= mesh.positions.size()) {
-                return Error{who + ": triangle " + std::to_string(i) + " vertex index " + std::to_string(v) +
-                             " is beyond the vertex list (size " + std::to_string(mesh.positions.size()) + ")"};
-            }
+            if (v >= mesh.positions.size()) return vertex_index_error(mesh, i, std::uint64_t{v});
         }
     }
     return {};

@@ -115,17 +115,25 @@ std::string stem_of(const std::string& source) { return std::filesystem::path(so
 
 }  // namespace
 
-Result<std::vector<Mesh>> parse_mesh(std::string_view bytes, MeshFormat format, const std::string& source) {
+Result<std::vector<Mesh>> parse_mesh(std::string_view bytes, MeshFormat format, const std::string& source,
+                                     MeshReadInfo* info) {
     const std::string stem = stem_of(source);
+    MeshReadInfo read;
+    read.format = format;
+    Result<std::vector<Mesh>> meshes = Error{source + ": unknown mesh format"};
     switch (format) {
         case MeshFormat::Obj:
-            return mesh_io_detail::parse_obj(bytes, source, stem);
+            meshes = mesh_io_detail::parse_obj(bytes, source, stem, read.obj_skipped);
+            break;
         case MeshFormat::Ply:
-            return mesh_io_detail::parse_ply(bytes, source, stem);
+            meshes = mesh_io_detail::parse_ply(bytes, source, stem);
+            break;
         case MeshFormat::Stl:
-            return mesh_io_detail::parse_stl(bytes, source, stem);
+            meshes = mesh_io_detail::parse_stl(bytes, source, stem);
+            break;
     }
-    return Error{source + ": unknown mesh format"};
+    if (meshes && info != nullptr) *info = read;
+    return meshes;
 }
 
 Result<MeshFormat> mesh_format_from_path(const std::string& path) {
@@ -140,7 +148,7 @@ Result<MeshFormat> mesh_format_from_path(const std::string& path) {
                  " (expected .obj, .ply or .stl)"};
 }
 
-Result<std::vector<Mesh>> read_mesh_file(const std::string& path) {
+Result<std::vector<Mesh>> read_mesh_file(const std::string& path, MeshReadInfo* info) {
     Result<MeshFormat> format = mesh_format_from_path(path);
     if (!format) return format.error();
     std::error_code ec;
@@ -156,7 +164,7 @@ Result<std::vector<Mesh>> read_mesh_file(const std::string& path) {
     const bool failed = std::ferror(file) != 0;
     std::fclose(file);
     if (failed) return Error{path + ": read error"};
-    return parse_mesh(bytes, format.value(), path);
+    return parse_mesh(bytes, format.value(), path, info);
 }
 
 namespace {

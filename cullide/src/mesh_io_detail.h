@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cullide/mesh.h"
+#include "cullide/mesh_io.h"
 #include "cullide/result.h"
 
 namespace cullide::mesh_io_detail {
@@ -19,8 +20,9 @@ namespace cullide::mesh_io_detail {
 inline constexpr std::uint64_t kMaxVertices = 0xFFFFFFFFull;
 
 // The three readers. `source` prefixes every message; `stem` names the meshes.
+// parse_obj fills `skipped` (always given) only on success.
 [[nodiscard]] Result<std::vector<Mesh>> parse_obj(std::string_view bytes, const std::string& source,
-                                                  const std::string& stem);
+                                                  const std::string& stem, MeshReadInfo::ObjSkipped& skipped);
 [[nodiscard]] Result<std::vector<Mesh>> parse_ply(std::string_view bytes, const std::string& source,
                                                   const std::string& stem);
 [[nodiscard]] Result<std::vector<Mesh>> parse_stl(std::string_view bytes, const std::string& source,

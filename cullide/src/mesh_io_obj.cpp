@@ -10,10 +10,15 @@
 // - `o name` / `g name...`: faces that follow belong to the object of that name; statements repeating a
 //   name continue the same object; `g`/`o` without a name returns to the ungrouped object. Objects are
 //   returned in the order of their first face; a name that never gets a face is not an object.
-// - Statements carrying data we do not keep are skipped: vt vn vp l p s usemtl mtllib (vt and vn are
-//   counted so that face references to them can be range-checked). Anything else is an error: a
-//   lenient reader that skips what it does not understand silently loses geometry (free-form
-//   surfaces, a corrupted line), and collision results on a partial mesh are wrong without warning.
+// - Statements carrying data we do not keep are skipped and counted per keyword (MeshReadInfo): vt vn
+//   vp l p s usemtl mtllib (the vt and vn counts also range-check face references to them). Anything
+//   else is an error: a lenient reader that skips what it does not understand silently loses geometry
+//   (free-form surfaces, a corrupted line), and collision results on a partial mesh are wrong without
+//   warning.
+// - A first statement of exactly two unsigned integers is the "<vertices> <faces>" count line FCL's
+//   test meshes begin with. It is checked against the `v` and `f` statements the file really holds
+//   (a file cut short, or a count line that is really something else, must not pass silently), then
+//   dropped. Anywhere else such a line is an error.
 #include <algorithm>
 #include <cstdint>
 #include <map>
@@ -117,9 +122,27 @@ bool resolve_reference(std::string_view token, std::uint64_t size, const char* w
     return true;
 }
 
-bool is_skipped_statement(std::string_view keyword) {
-    static constexpr std::string_view kSkipped[] = {"vt", "vn", "vp", "l", "p", "s", "usemtl", "mtllib"};
-    return std::find(std::begin(kSkipped), std::end(kSkipped), keyword) != std::end(kSkipped);
+// The counter of a statement read and dropped, or nullptr when `keyword` is not one of them.
+std::uint64_t* skipped_counter(std::string_view keyword, MeshReadInfo::ObjSkipped& skipped) {
+    if (keyword == "vt") return &skipped.vt;
+    if (keyword == "vn") return &skipped.vn;
+    if (keyword == "vp") return &skipped.vp;
+    if (keyword == "l") return &skipped.l;
+    if (keyword == "p") return &skipped.p;
+    if (keyword == "s") return &skipped.s;
+    if (keyword == "usemtl") return &skipped.usemtl;
+    if (keyword == "mtllib") return &skipped.mtllib;
+    return nullptr;
+}
+
+// FCL's "<vertices> <faces>" line: exactly two unsigned decimal integers.
+bool is_count_line(const std::vector<std::string_view>& words, std::uint64_t& vertices, std::uint64_t& faces) {
+    return words.size() == 2 && parse_unsigned(words[0], vertices) == NumberStatus::Ok &&
+           parse_unsigned(words[1], faces) == NumberStatus::Ok;
+}
+
+std::string count_of(std::uint64_t n, const char* one, const char* many) {
+    return std::to_string(n) + " " + (n == 1 ? one : many);
 }
 
 // Every object keeps only the vertices its faces reference, in increasing file order. `scratch` has
@@ -149,10 +172,15 @@ Mesh compact(const ObjObject& object, const std::vector<Vec3>& positions,
 }  // namespace
 
 Result<std::vector<Mesh>> parse_obj(std::string_view bytes, const std::string& source,
-                                    const std::string& stem) {
+                                    const std::string& stem, MeshReadInfo::ObjSkipped& skipped_out) {
     std::vector<Vec3> positions;
-    std::uint64_t texcoord_count = 0;
-    std::uint64_t normal_count = 0;
+    MeshReadInfo::ObjSkipped skipped;  // written to skipped_out only on success
+    const std::uint64_t& texcoord_count = skipped.vt;
+    const std::uint64_t& normal_count = skipped.vn;
+    std::uint64_t face_count = 0;  // `f` statements (polygons, before triangulation)
+    bool first_statement = true;
+    std::uint64_t declared_vertices = 0, declared_faces = 0;
+    std::size_t count_line_number = 0;
     std::vector<ObjObject> objects;
     std::map<std::string, std::size_t> object_by_name;  // lookup only; output order is first-face order
     std::string current_name = stem;                    // the ungrouped object is named by the stem alone
@@ -171,6 +199,20 @@ Result<std::vector<Mesh>> parse_obj(std::string_view bytes, const std::string& s
         split_words(line, words);
         if (words.empty()) continue;
         const std::string_view keyword = words[0];
+        const bool first = first_statement;
+        first_statement = false;
+        std::uint64_t vertices = 0, faces = 0;
+        if (is_count_line(words, vertices, faces)) {
+            if (!first) {
+                return fail("count line " + quote(trim(line)) +
+                            " ('<vertices> <faces>') is accepted only as the first statement");
+            }
+            skipped.count_line = 1;
+            declared_vertices = vertices;
+            declared_faces = faces;
+            count_line_number = line_number;
+            continue;
+        }
 
         if (keyword == "v") {
             const std::size_t n = words.size() - 1;
@@ -239,6 +281,7 @@ Result<std::vector<Mesh>> parse_obj(std::string_view bytes, const std::string& s
                 if (inserted) objects.push_back({current_name, {}});
                 current_object = it->second;
             }
+            ++face_count;
             std::vector<Tri>& tris = objects[current_object].triangles;
             for (std::size_t k = 1; k + 1 < polygon.size(); ++k)
                 tris.push_back({polygon[0], polygon[k], polygon[k + 1]});
@@ -251,16 +294,21 @@ Result<std::vector<Mesh>> parse_obj(std::string_view bytes, const std::string& s
             current_name = name.empty() ? stem : stem + "/" + name;
             const auto it = object_by_name.find(current_name);
             current_object = it == object_by_name.end() ? SIZE_MAX : it->second;
-        } else if (keyword == "vt") {
-            ++texcoord_count;
-        } else if (keyword == "vn") {
-            ++normal_count;
-        } else if (!is_skipped_statement(keyword)) {
+        } else if (std::uint64_t* counter = skipped_counter(keyword, skipped)) {
+            ++*counter;
+        } else {
             return fail("unknown or unsupported statement " + quote(keyword));
         }
     }
 
+    if (skipped.count_line != 0 && (declared_vertices != positions.size() || declared_faces != face_count)) {
+        return Error{source + ":" + std::to_string(count_line_number) + ": the count line says " +
+                     count_of(declared_vertices, "vertex", "vertices") + " and " + count_of(declared_faces, "face", "faces") +
+                     " but the file has " + count_of(positions.size(), "vertex", "vertices") + " and " +
+                     count_of(face_count, "face", "faces")};
+    }
     if (objects.empty()) return Error{source + ": no triangles (the file has no faces)"};
+    skipped_out = skipped;
     std::vector<Mesh> meshes;
     if (objects.size() == 1) {
         // One object: keep the file's vertex list and numbering as is, unreferenced vertices included.

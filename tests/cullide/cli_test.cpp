@@ -139,6 +139,39 @@ TEST_CASE("mesh files are objects in argument order and --self reports pairs ins
     std::filesystem::remove(path);
 }
 
+TEST_CASE("--json reports, per input file, the statements its reader skipped") {
+    const auto fcl = temp_path("skips_fcl.obj");
+    const auto plain = temp_path("skips_plain.obj");
+    {
+        std::ofstream f(fcl);
+        f << "3 1\nmtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nusemtl a\ns off\nf 1/1 2/2 3/1\n";
+        std::ofstream g(plain);
+        g << "v 0 0 2\nv 1 0 2\nv 0 1 2\nf 1 2 3\n";
+    }
+    Outcome o = run({"run", fcl.string(), plain.string(), "--method", "exact", "--json"});
+    REQUIRE(o.status == 0);
+    CHECK(has(o.out, "\"inputs\": [{\"file\": \"" + fcl.string() +
+                         "\", \"skipped\": {\"vt\": 2, \"vn\": 0, \"vp\": 0, \"l\": 0, \"p\": 0, \"s\": 1, "
+                         "\"usemtl\": 1, \"mtllib\": 1, \"count_line\": 1}}, {\"file\": \"" +
+                         plain.string() +
+                         "\", \"skipped\": {\"vt\": 0, \"vn\": 0, \"vp\": 0, \"l\": 0, \"p\": 0, \"s\": 0, "
+                         "\"usemtl\": 0, \"mtllib\": 0, \"count_line\": 0}}], \"frames\": ["));
+    // A built-in scene has no input files.
+    Outcome scene = run({"run", "--method", "exact", "--scale", "0.1", "--frames", "1", "--json"});
+    REQUIRE(scene.status == 0);
+    CHECK(has(scene.out, "\"inputs\": [], \"frames\": ["));
+    // A count line that disagrees with the file is an input error naming the file and line.
+    {
+        std::ofstream f(fcl);
+        f << "4 1\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    }
+    Outcome bad = run({"run", fcl.string(), "--json"});
+    CHECK(bad.status == 1);
+    CHECK(has(bad.err, fcl.string() + ":1: the count line says 4 vertices and 1 face but the file has 3 vertices"));
+    std::filesystem::remove(fcl);
+    std::filesystem::remove(plain);
+}
+
 TEST_CASE("the README's library example is the file the build compiles") {
     const std::string readme = read_file(std::filesystem::path(CULLIDE_SOURCE_DIR) / "README.md");
     const std::string example = read_file(std::filesystem::path(CULLIDE_SOURCE_DIR) / "tests/cullide/readme_example.cpp");

@@ -275,6 +275,121 @@ TEST_CASE("malformed OBJ input gives an error naming the file, the line and the 
     }
 }
 
+TEST_CASE("OBJ statements skipped are counted per keyword and reported only on success") {
+    const std::string obj =
+        "mtllib a.mtl\nmtllib b.mtl\n"
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+        "vt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\nvp 0.5\n"
+        "usemtl red\ns 1\ns off\ns 2\n"
+        "l 1 2\np 3\n"
+        "f 1/1 2/2 3/3\n";
+    cullide::MeshReadInfo info;
+    cullide::Result<std::vector<Mesh>> r = cullide::parse_mesh(obj, MeshFormat::Obj, "skip.obj", &info);
+    REQUIRE(r.ok());
+    CHECK(info.format == MeshFormat::Obj);
+    cullide::MeshReadInfo::ObjSkipped expected;
+    expected.vt = 3;
+    expected.vn = 1;
+    expected.vp = 1;
+    expected.l = 1;
+    expected.p = 1;
+    expected.s = 3;
+    expected.usemtl = 1;
+    expected.mtllib = 2;
+    CHECK(info.obj_skipped == expected);
+    const auto listed = info.skipped();
+    const char* names[] = {"vt", "vn", "vp", "l", "p", "s", "usemtl", "mtllib", "count_line"};
+    const std::uint64_t counts[] = {3, 1, 1, 1, 1, 3, 1, 2, 0};
+    for (std::size_t i = 0; i < listed.size(); ++i) {
+        CAPTURE(i);
+        CHECK(listed[i].first == names[i]);
+        CHECK(listed[i].second == counts[i]);
+    }
+
+    // A failed call leaves the caller's info as it was; the other formats skip no statements.
+    cullide::MeshReadInfo untouched;
+    untouched.obj_skipped.vt = 77;
+    CHECK_FALSE(cullide::parse_mesh("vt 0 0\nv 0 0 0\nf 1 1 x\n", MeshFormat::Obj, "bad.obj", &untouched).ok());
+    CHECK(untouched.obj_skipped.vt == 77);
+    const std::string ply =
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+        "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    cullide::MeshReadInfo ply_info;
+    ply_info.obj_skipped.s = 5;
+    REQUIRE(cullide::parse_mesh(ply, MeshFormat::Ply, "t.ply", &ply_info).ok());
+    CHECK(ply_info.format == MeshFormat::Ply);
+    CHECK(ply_info.obj_skipped == cullide::MeshReadInfo::ObjSkipped{});
+}
+
+TEST_CASE("an OBJ file may begin with FCL's '<vertices> <faces>' count line, checked against the file") {
+    // The form of FCL's test meshes (test/fcl_resources/rob.obj begins "648 216"), after a comment.
+    const std::string obj =
+        "# exported by a tool\n\n"
+        "4 2\n"
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
+        "f 1 2 3\nf 2 4 3\n";
+    cullide::MeshReadInfo info;
+    cullide::Result<std::vector<Mesh>> r = cullide::parse_mesh(obj, MeshFormat::Obj, "fcl.obj", &info);
+    REQUIRE(r.ok());
+    REQUIRE(r.value().size() == 1);
+    CHECK(r.value()[0].positions.size() == 4);
+    CHECK(r.value()[0].triangles == std::vector<Tri>{{0, 1, 2}, {1, 3, 2}});
+    CHECK(info.obj_skipped.count_line == 1);
+
+    // Faces are counted as `f` statements (polygons), not triangles: one quad is one face.
+    CHECK(load("4 1\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n", MeshFormat::Obj, "q.obj")[0]
+              .triangles.size() == 2);
+    // Without the line nothing is counted.
+    cullide::MeshReadInfo plain;
+    REQUIRE(cullide::parse_mesh("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", MeshFormat::Obj, "p.obj", &plain).ok());
+    CHECK(plain.obj_skipped.count_line == 0);
+}
+
+TEST_CASE("a count line that disagrees with the file, or is not the first statement, is an error") {
+    struct Case {
+        const char* text;
+        const char* message;
+    };
+    const Case cases[] = {
+        {"4 2\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 3 2\n",
+         "bad.obj:1: the count line says 4 vertices and 2 faces but the file has 3 vertices and 2 faces"},
+        {"# c\n3 2\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+         "bad.obj:2: the count line says 3 vertices and 2 faces but the file has 3 vertices and 1 face"},
+        {"1 1\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+         "bad.obj:1: the count line says 1 vertex and 1 face but the file has 3 vertices and 1 face"},
+        {"3 0\nv 0 0 0\nv 1 0 0\nv 0 1 0\n", "bad.obj: no triangles (the file has no faces)"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\n3 1\nf 1 2 3\n",
+         "bad.obj:4: count line '3 1' ('<vertices> <faces>') is accepted only as the first statement"},
+        {"3 1\n3 1\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+         "bad.obj:2: count line '3 1' ('<vertices> <faces>') is accepted only as the first statement"},
+        // Not two unsigned integers: not a count line, so an unknown statement as before.
+        {"3\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "bad.obj:1: unknown or unsupported statement '3'"},
+        {"3 1 0\nv 0 0 0\n", "bad.obj:1: unknown or unsupported statement '3'"},
+        {"-3 1\nv 0 0 0\n", "bad.obj:1: unknown or unsupported statement '-3'"},
+        {"3 1.0\nv 0 0 0\n", "bad.obj:1: unknown or unsupported statement '3'"},
+        // Malformed v and f lines are still refused after a count line.
+        {"3 1\nv 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "bad.obj:2: vertex has 2 values (expected x y z [w])"},
+        {"3 1\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n",
+         "bad.obj:5: face index 4 is beyond the vertex list (size 3)"},
+    };
+    for (const Case& c : cases) {
+        CAPTURE(c.text);
+        CHECK(error_of(c.text, MeshFormat::Obj, "bad.obj") == c.message);
+    }
+}
+
+TEST_CASE("read_mesh_file reports what it skipped through the optional MeshReadInfo") {
+    const std::filesystem::path p = std::filesystem::temp_directory_path() / "cullide_mesh_io_info.obj";
+    std::ofstream(p, std::ios::binary) << "3 1\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n";
+    cullide::MeshReadInfo info;
+    cullide::Result<std::vector<Mesh>> r = cullide::read_mesh_file(p.string(), &info);
+    REQUIRE(r.ok());
+    CHECK(info.obj_skipped.count_line == 1);
+    CHECK(info.obj_skipped.vn == 1);
+    CHECK(cullide::read_mesh_file(p.string()).ok());  // the old call, without info
+    std::filesystem::remove(p);
+}
+
 // ---------------------------------------------------------------- PLY
 
 TEST_CASE("an ASCII PLY file loads, skipping extra properties and elements, lists included") {

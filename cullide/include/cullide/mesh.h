@@ -60,6 +60,11 @@ struct Aabb {
 // Checks a mesh a caller built: every position finite, every index in range, at least one
 // triangle. The error names the mesh, the element and the limit.
 [[nodiscard]] Status validate_mesh(const Mesh& mesh);
+// validate_mesh's message for vertex index `index` of triangle `triangle` outside the vertex list of
+// `mesh` (mesh.positions holds the list). Public so that callers holding signed or wider indices than
+// Tri (cullide/eigen.h) word a negative or too-large index exactly as validate_mesh does.
+[[nodiscard]] Error vertex_index_error(const Mesh& mesh, std::size_t triangle, std::int64_t index);
+[[nodiscard]] Error vertex_index_error(const Mesh& mesh, std::size_t triangle, std::uint64_t index);
 // The same over a scene; the message also names the object's index.
 [[nodiscard]] Status validate_scene(std::span<const Mesh> objects);
 
