@@ -25,8 +25,11 @@ foreach(module raster spatialhash cullide)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${module}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
           FILES_MATCHING PATTERN "*.h")
 endforeach()
+# The Eigen front door is a component of its own (its own export set), so that the package needs
+# Eigen only when a consumer asks for it: find_package(cullide CONFIG COMPONENTS eigen).
 if(TARGET cullide_eigen)
-  install(TARGETS cullide_eigen EXPORT cullideTargets)
+  install(TARGETS cullide_eigen EXPORT cullideEigenTargets)
+  install(EXPORT cullideEigenTargets NAMESPACE cullide:: DESTINATION ${CULLIDE_INSTALL_CMAKEDIR})
 endif()
 install(TARGETS cullide_cli RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # The man page is generated from the CLI's option table at build time (absent when cross-compiling).
@@ -73,5 +76,8 @@ if(CULLIDE_DPKG_SHLIBDEPS)
 endif()
 if(CULLIDE_HAVE_TBB)
   set(CPACK_DEBIAN_PACKAGE_DEPENDS "libtbb-dev")
+endif()
+if(TARGET cullide_eigen)
+  set(CPACK_DEBIAN_PACKAGE_SUGGESTS "libeigen3-dev")  # for the cullide::eigen component only
 endif()
 include(CPack)
