@@ -9,8 +9,8 @@
 #include <string>
 
 #include "cullide/predicates.h"
-#include "cullide/tri_tri.h"
 #include "cullide_detail.h"
+#include "exact_stage.h"
 #include "emulator_device.h"
 #include "parallel.h"
 #include "raster/command_batch.h"
@@ -380,145 +380,26 @@ Status check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t
                                            o.threads);
 }
 
-// The triangles of the surviving sub-objects, paired across objects and tested exactly. As in the
-// ground truth (ground_truth.cpp): one task per pair of objects whose live boxes overlap, holding
-// only the live sub-objects whose boxes meet the intersection of the two, swept and pruned on the
-// axis where their centres spread most. A task sweeps sub-object boxes and then compares the
-// triangle boxes of each overlapping sub-object pair, unless its sub-object boxes are loose (the
-// consecutive triangles of a scrambled or thinned mesh lie far apart: their boxes' summed extent
-// along the axis is more than 4 times their triangles', so the sub-object sweep would meet more
-// overlaps than a sweep over the triangles, which has 4 times as many boxes); then it sweeps the
-// triangle boxes directly. On the thinned bunny-dragon the sub-object sweep met 1.4 million
-// sub-object pairs for 218 triangle pairs. Either way the triangle pairs tested are the same: the
-// live triangles of the two objects whose boxes overlap (two such boxes meet inside the common box).
+// The triangles of the surviving sub-objects, paired across objects and tested exactly: each live
+// sub-object is a candidate set of the exact stage (exact_stage.h).
 std::vector<TrianglePair> exact_stage(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
                                       const std::vector<ObjectGeometry>& g, int threads, CullideStats& st) {
-    struct Ref {  // a sub-object (tri = UINT32_MAX) or one of its triangles
-        std::uint32_t geom, item, tri;
-        const Aabb* box;
-    };
-    constexpr std::uint32_t kItem = 0xffffffffu;
-    std::vector<Aabb> live_box(g.size());
-    std::vector<char> has_live(g.size(), 0);
+    std::vector<detail::ExactObject> exact(g.size());
+    std::vector<detail::CandidateSet> sets;
     for (std::size_t i = 0; i < g.size(); ++i) {
+        const std::uint32_t object = active[g[i].active_index];
+        exact[i] = {&objects[object], object, Aabb{}, g[i].triangle_boxes, {}, {}};
         for (const Item& it : g[i].items) {
             if (!it.live) continue;
-            has_live[i] = 1;
-            live_box[i] = unite(live_box[i], it.box);
+            sets.push_back({static_cast<std::uint32_t>(i), it.first_index / 3, it.index_count / 3, it.box});
+            exact[i].box = unite(exact[i].box, it.box);
             st.candidate_triangles += it.index_count / 3;
         }
     }
-    struct Task {
-        std::vector<Ref> refs;  // sorted by (lo[axis], geom, item, tri): a unique key
-        int axis = 0;
-    };
-    std::vector<Task> tasks;
-    for (std::size_t i = 0; i < g.size(); ++i) {
-        if (!has_live[i]) continue;
-        for (std::size_t j = i + 1; j < g.size(); ++j) {
-            if (!has_live[j] || !overlaps(live_box[i], live_box[j])) continue;
-            Aabb common;
-            for (int k = 0; k < 3; ++k) {
-                common.lo[k] = std::max(live_box[i].lo[k], live_box[j].lo[k]);
-                common.hi[k] = std::min(live_box[i].hi[k], live_box[j].hi[k]);
-            }
-            Task task;
-            std::size_t from_i = 0;
-            for (const std::size_t o : {i, j}) {
-                for (std::size_t k = 0; k < g[o].items.size(); ++k) {
-                    const Item& it = g[o].items[k];
-                    if (it.live && overlaps(it.box, common))
-                        task.refs.push_back({static_cast<std::uint32_t>(o), static_cast<std::uint32_t>(k), kItem, &it.box});
-                }
-                if (o == i) from_i = task.refs.size();
-            }
-            if (from_i == 0 || from_i == task.refs.size()) continue;  // one side has nothing there
-            Aabb centres;
-            for (const Ref& r : task.refs) {
-                const double cx = 0.5 * r.box->lo.x + 0.5 * r.box->hi.x, cy = 0.5 * r.box->lo.y + 0.5 * r.box->hi.y,
-                             cz = 0.5 * r.box->lo.z + 0.5 * r.box->hi.z;
-                centres = unite(centres, Aabb{{cx, cy, cz}, {cx, cy, cz}});
-            }
-            for (int k = 1; k < 3; ++k)
-                if (centres.hi[k] - centres.lo[k] > centres.hi[task.axis] - centres.lo[task.axis]) task.axis = k;
-            const int axis = task.axis;
-            double item_extent = 0.0, tri_extent = 0.0;
-            for (const Ref& r : task.refs) {
-                item_extent += r.box->hi[axis] - r.box->lo[axis];
-                const Item& it = g[r.geom].items[r.item];
-                for (std::uint32_t t = it.first_index / 3; t < (it.first_index + it.index_count) / 3; ++t)
-                    tri_extent += g[r.geom].triangle_boxes[t].hi[axis] - g[r.geom].triangle_boxes[t].lo[axis];
-            }
-            if (item_extent > 4.0 * tri_extent) {  // loose sub-objects: sweep their triangles instead
-                std::vector<Ref> tris;
-                for (const Ref& r : task.refs) {
-                    const Item& it = g[r.geom].items[r.item];
-                    for (std::uint32_t t = it.first_index / 3; t < (it.first_index + it.index_count) / 3; ++t)
-                        if (overlaps(g[r.geom].triangle_boxes[t], common))
-                            tris.push_back({r.geom, r.item, t, &g[r.geom].triangle_boxes[t]});
-                }
-                task.refs = std::move(tris);
-            }
-            std::sort(task.refs.begin(), task.refs.end(), [axis](const Ref& a, const Ref& b) {
-                if (a.box->lo[axis] != b.box->lo[axis]) return a.box->lo[axis] < b.box->lo[axis];
-                if (a.geom != b.geom) return a.geom < b.geom;
-                if (a.item != b.item) return a.item < b.item;
-                return a.tri < b.tri;
-            });
-            tasks.push_back(std::move(task));
-        }
-    }
-    // Per task (tasks in a fixed order, each on one worker): its triangle pairs, lower geom first,
-    // in sweep order, each tested exactly.
-    struct TriPair {
-        std::uint32_t geom_a, item_a, tri_a, geom_b, item_b, tri_b;
-    };
-    std::vector<std::vector<TriPair>> task_pairs(tasks.size());
-    std::vector<std::vector<TrianglePair>> found(tasks.size());
-    detail::parallel_chunks(threads, tasks.size(), [&](std::size_t t) {
-        const std::vector<Ref>& refs = tasks[t].refs;
-        const int axis = tasks[t].axis;
-        auto& tp = task_pairs[t];
-        for (std::size_t a = 0; a < refs.size(); ++a) {
-            for (std::size_t b = a + 1; b < refs.size() && refs[b].box->lo[axis] <= refs[a].box->hi[axis]; ++b) {
-                if (refs[a].geom == refs[b].geom || !overlaps(*refs[a].box, *refs[b].box)) continue;
-                const Ref& ra = refs[a].geom < refs[b].geom ? refs[a] : refs[b];
-                const Ref& rb = refs[a].geom < refs[b].geom ? refs[b] : refs[a];
-                if (ra.tri != kItem) {
-                    tp.push_back({ra.geom, ra.item, ra.tri, rb.geom, rb.item, rb.tri});
-                    continue;
-                }
-                const Item& ia = g[ra.geom].items[ra.item];
-                const Item& ib = g[rb.geom].items[rb.item];
-                for (std::uint32_t ta = ia.first_index / 3; ta < (ia.first_index + ia.index_count) / 3; ++ta)
-                    for (std::uint32_t tb = ib.first_index / 3; tb < (ib.first_index + ib.index_count) / 3; ++tb)
-                        if (overlaps(g[ra.geom].triangle_boxes[ta], g[rb.geom].triangle_boxes[tb]))
-                            tp.push_back({ra.geom, ra.item, ta, rb.geom, rb.item, tb});
-            }
-        }
-        for (const TriPair& p : tp) {
-            const std::uint32_t oa = active[g[p.geom_a].active_index];
-            const std::uint32_t ob = active[g[p.geom_b].active_index];
-            const Mesh& ma = objects[oa];
-            const Mesh& mb = objects[ob];
-            const Tri& a = ma.triangles[p.tri_a];
-            const Tri& b = mb.triangles[p.tri_b];
-            if (tri_tri_intersect(ma.positions[a[0]], ma.positions[a[1]], ma.positions[a[2]], mb.positions[b[0]],
-                                  mb.positions[b[1]], mb.positions[b[2]]))
-                found[t].push_back({oa, p.tri_a, ob, p.tri_b});
-        }
-    });
-    std::vector<TrianglePair> pairs;
-    std::vector<std::array<std::uint32_t, 4>> keys;  // sub-object pairs holding some tested pair
-    for (std::size_t t = 0; t < tasks.size(); ++t) {
-        st.exact_tests += task_pairs[t].size();
-        for (const TriPair& p : task_pairs[t]) keys.push_back({p.geom_a, p.item_a, p.geom_b, p.item_b});
-        pairs.insert(pairs.end(), found[t].begin(), found[t].end());
-    }
-    std::sort(keys.begin(), keys.end());
-    st.subobject_pairs = static_cast<std::uint64_t>(std::unique(keys.begin(), keys.end()) - keys.begin());
-    std::sort(pairs.begin(), pairs.end());
-    return pairs;
+    detail::ExactStageResult r = detail::sweep_exact_stage(exact, sets, {false, true, threads});
+    st.exact_tests = r.stats.tests;
+    st.subobject_pairs = r.stats.set_pairs;
+    return std::move(r.pairs);
 }
 
 }  // namespace

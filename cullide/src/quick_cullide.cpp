@@ -6,8 +6,8 @@
 #include <chrono>
 #include <string>
 
-#include "cullide/tri_tri.h"
 #include "cullide_detail.h"
+#include "exact_stage.h"
 #include "parallel.h"
 #include "raster/command_batch.h"
 #include "raster/depth_target.h"
@@ -331,43 +331,17 @@ void set_object_near(std::vector<Item>& items) {
 
 bool near(const Item& a, std::size_t b) { return b >= a.near_lo && b <= a.near_hi; }
 
-bool share_vertex(const Geom& g, const Mesh& m, std::uint32_t ta, std::uint32_t tb) {
-    for (std::uint32_t va : m.triangles[ta])
-        for (std::uint32_t vb : m.triangles[tb])
-            if (g.weld[va] == g.weld[vb]) return true;
-    return false;
-}
-
 using ItemPair = std::pair<std::uint32_t, std::uint32_t>;
 
-// Item pairs (a < b) whose boxes overlap, by sweep and prune on the axis of greatest extent; BFV
-// items only when `with_bfv`. Sorted.
-std::vector<ItemPair> box_pairs(const std::vector<Item>& items, bool with_bfv) {
-    std::vector<std::uint32_t> refs;
-    Aabb all;
+// Item pairs (a < b) whose boxes overlap, by sweep and prune (exact_stage.h); BFV items only when
+// `with_bfv`. Sorted.
+std::vector<ItemPair> box_pairs(const std::vector<Item>& items, bool with_bfv, int threads) {
+    std::vector<detail::SweepRef> refs;
     for (std::size_t i = 0; i < items.size(); ++i) {
         if (items[i].tag == kBFV && !with_bfv) continue;
-        refs.push_back(static_cast<std::uint32_t>(i));
-        all = detail::unite(all, items[i].box);
+        refs.push_back({items[i].box, items[i].geom, static_cast<std::uint32_t>(i), detail::kWholeSet});
     }
-    std::vector<ItemPair> out;
-    if (refs.empty()) return out;
-    int axis = 0;
-    for (int k = 1; k < 3; ++k)
-        if (all.hi[k] - all.lo[k] > all.hi[axis] - all.lo[axis]) axis = k;
-    std::sort(refs.begin(), refs.end(), [&](std::uint32_t x, std::uint32_t y) {
-        if (items[x].box.lo[axis] != items[y].box.lo[axis]) return items[x].box.lo[axis] < items[y].box.lo[axis];
-        return x < y;
-    });
-    for (std::size_t i = 0; i < refs.size(); ++i) {
-        const Item& ri = items[refs[i]];
-        for (std::size_t j = i + 1; j < refs.size() && items[refs[j]].box.lo[axis] <= ri.box.hi[axis]; ++j) {
-            if (!overlaps(ri.box, items[refs[j]].box)) continue;
-            out.emplace_back(std::min(refs[i], refs[j]), std::max(refs[i], refs[j]));
-        }
-    }
-    std::sort(out.begin(), out.end());
-    return out;
+    return detail::overlapping_sets(std::move(refs), threads);
 }
 
 // Self-collision box classification (ours, before the visibility passes): an item whose box meets
@@ -387,10 +361,7 @@ void box_tags(std::vector<Item>& items, const std::vector<ItemPair>& overlapping
 std::vector<TrianglePair> exact_stage(std::span<const Mesh> objects, const std::vector<Geom>& geoms,
                                       const std::vector<Item>& items, const std::vector<ItemPair>& overlapping,
                                       const QuickOptions& o, QuickStats& st) {
-    struct Pair {
-        std::uint32_t a, b;
-        bool near;
-    };
+    using Pair = detail::CandidatePair;
     std::vector<Pair> pairs;
     if (o.self)
         for (std::size_t i = 0; i < items.size(); ++i)
@@ -413,55 +384,16 @@ std::vector<TrianglePair> exact_stage(std::span<const Mesh> objects, const std::
         }
     }
 
-    constexpr std::size_t kChunk = 64;  // item pairs per task: fixed, so the output is thread-independent
-    const std::size_t chunks = (pairs.size() + kChunk - 1) / kChunk;
-    struct ChunkOut {
-        std::vector<TrianglePair> found;
-        std::uint64_t tests = 0, near_tests = 0, adjacent = 0;
-    };
-    std::vector<ChunkOut> out(chunks);
-    detail::parallel_chunks(o.threads, chunks, [&](std::size_t c) {
-        ChunkOut& co = out[c];
-        const std::size_t end = std::min(pairs.size(), (c + 1) * kChunk);
-        for (std::size_t p = c * kChunk; p < end; ++p) {
-            const Item& ia = items[pairs[p].a];
-            const Item& ib = items[pairs[p].b];
-            const Geom& ga = geoms[ia.geom];
-            const Geom& gb = geoms[ib.geom];
-            const Mesh& ma = objects[ga.object];
-            const Mesh& mb = objects[gb.object];
-            const bool same = ia.geom == ib.geom;
-            for (std::uint32_t pa = ia.first; pa < ia.first + ia.count; ++pa) {
-                const std::uint32_t first_b = pairs[p].a == pairs[p].b ? pa + 1 : ib.first;
-                for (std::uint32_t pb = first_b; pb < ib.first + ib.count; ++pb) {
-                    if (!overlaps(ga.tri_box[pa], gb.tri_box[pb])) continue;
-                    std::uint32_t ta = ga.order[pa], tb = gb.order[pb];
-                    if (same && share_vertex(ga, ma, ta, tb)) {
-                        ++co.adjacent;
-                        continue;
-                    }
-                    ++co.tests;
-                    co.near_tests += pairs[p].near ? 1 : 0;
-                    const Tri& a = ma.triangles[ta];
-                    const Tri& b = mb.triangles[tb];
-                    if (tri_tri_intersect(ma.positions[a[0]], ma.positions[a[1]], ma.positions[a[2]], mb.positions[b[0]],
-                                          mb.positions[b[1]], mb.positions[b[2]])) {
-                        if (same && tb < ta) std::swap(ta, tb);
-                        co.found.push_back({ga.object, ta, gb.object, tb});
-                    }
-                }
-            }
-        }
-    });
-    std::vector<TrianglePair> result;
-    for (const ChunkOut& co : out) {
-        st.exact_tests += co.tests;
-        st.near_exact_tests += co.near_tests;
-        st.adjacent_skipped += co.adjacent;
-        result.insert(result.end(), co.found.begin(), co.found.end());
-    }
-    std::sort(result.begin(), result.end());
-    return result;
+    std::vector<detail::ExactObject> exact(geoms.size());
+    for (std::size_t g = 0; g < geoms.size(); ++g)
+        exact[g] = {&objects[geoms[g].object], geoms[g].object, Aabb{}, geoms[g].tri_box, geoms[g].order, geoms[g].weld};
+    std::vector<detail::CandidateSet> sets(items.size());
+    for (std::size_t i = 0; i < items.size(); ++i) sets[i] = {items[i].geom, items[i].first, items[i].count, items[i].box};
+    detail::ExactStageResult r = detail::listed_exact_stage(exact, sets, pairs, o.threads);
+    st.exact_tests = r.stats.tests;
+    st.near_exact_tests = r.stats.near_tests;
+    st.adjacent_skipped = r.stats.adjacent_skipped;
+    return std::move(r.pairs);
 }
 
 }  // namespace
@@ -574,7 +506,7 @@ Result<std::vector<TrianglePair>> quick_cullide_pairs(std::span<const Mesh> obje
         st.subobjects = items.size();
         // Box pairs once (they include BFV items: their near pairs stay open); the box tags leave
         // to the passes only the items with a far overlapping box.
-        overlapping = box_pairs(items, true);
+        overlapping = box_pairs(items, true, options.threads);
         if (!options.skip_visibility) box_tags(items, overlapping);
         st.pcs_boxes = count_live(items);
         if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, device, st); !s) return s.error();
@@ -583,7 +515,7 @@ Result<std::vector<TrianglePair>> quick_cullide_pairs(std::span<const Mesh> obje
     }
 
     auto t0 = Clock::now();
-    if (!options.self) overlapping = box_pairs(items, false);
+    if (!options.self) overlapping = box_pairs(items, false, options.threads);
     std::vector<TrianglePair> pairs = exact_stage(objects, geoms, items, overlapping, options, st);
     st.exact_ms = ms_since(t0);
     if (stats != nullptr) *stats = std::move(st);
