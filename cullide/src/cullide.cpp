@@ -11,7 +11,6 @@
 #include "cullide/predicates.h"
 #include "cullide_detail.h"
 #include "exact_stage.h"
-#include "emulator_device.h"
 #include "parallel.h"
 #include "raster/command_batch.h"
 #include "raster/offset_geometry.h"
@@ -90,7 +89,8 @@ void widen(double& lo, double& hi) {
 // The orthographic view along `axis` (raster::OrthoView: window axes are the next two in cyclic
 // order, depth grows along the axis) fitted to `bounds` widened as above, with `extra_depth` more
 // world units before and after along the axis (Offset mode).
-Result<raster::OrthoView> make_view(int axis, const Aabb& bounds, double extra_depth, const CullideOptions& o) {
+Result<raster::OrthoView> make_view(int axis, const Aabb& bounds, double extra_depth, ViewSize size,
+                                    raster::DepthFormat format) {
     std::array<double, 3> lo{bounds.lo.x, bounds.lo.y, bounds.lo.z};
     std::array<double, 3> hi{bounds.hi.x, bounds.hi.y, bounds.hi.z};
     for (std::size_t k = 0; k < 3; ++k) {
@@ -104,7 +104,7 @@ Result<raster::OrthoView> make_view(int axis, const Aabb& bounds, double extra_d
     }
     raster::Result<raster::OrthoView> v =
         raster::make_ortho_view(static_cast<raster::Axis>(axis), {lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]},
-                                o.resolution, o.resolution, o.depth_format);
+                                size.width(), size.height(), format);
     if (!v) return Error{"view: " + v.error().message};
     return v.value();
 }
@@ -228,10 +228,11 @@ void count_passes(const std::vector<ObjectGeometry>& g, const std::vector<std::s
     }
 }
 
-// Both passes of one view at once on the emulator (raster/visibility.h); prunes the fully visible
-// items. Same answers as recording them (tests/cullide/fused_visibility_test.cpp compares the two).
-Result<std::uint64_t> fused_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_t>& order,
-                                 const CullideOptions& o, int threads, raster::VisibilityPass& pass, ViewStats& vs) {
+// Both passes of one exact-bounds view as the device's visibility pass (query_device.h); prunes
+// the fully visible items. The fused and the recorded form give the same answers
+// (tests/cullide/fused_visibility_test.cpp compares the two).
+Result<std::uint64_t> visibility_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_t>& order,
+                                      const CullideOptions& o, ViewSize size, QueryDevice& device, ViewStats& vs) {
     std::vector<raster::VisibilityItem> items;
     std::vector<Item*> refs;
     for (std::size_t k = 0; k < order.size(); ++k) {
@@ -245,9 +246,10 @@ Result<std::uint64_t> fused_view(std::vector<ObjectGeometry>& g, const std::vect
         }
     }
     count_passes(g, order, vs);
-    raster::Result<std::vector<std::uint8_t>> r =
-        pass.run(o.resolution, o.resolution, o.depth_format, items, threads);
-    if (!r) return Error{"emulator device: " + r.error().message};
+    Result<std::vector<std::uint8_t>> r = o.fused_visibility
+                                              ? device.visibility_pass(size, o.depth_format, items)
+                                              : device.recorded_visibility_pass(size, o.depth_format, items);
+    if (!r) return r.error();
     std::uint64_t pruned = 0;
     for (std::size_t i = 0; i < refs.size(); ++i) {
         if (r.value()[i] == 0) {
@@ -258,15 +260,44 @@ Result<std::uint64_t> fused_view(std::vector<ObjectGeometry>& g, const std::vect
     return pruned;
 }
 
+// Both passes of one GL-exact or offset view, recorded and run on the device; prunes the fully
+// visible items.
+Result<std::uint64_t> recorded_view(std::vector<ObjectGeometry>& g, std::vector<std::size_t> order,
+                                    const CullideOptions& o, ViewSize size, QueryDevice& device, ViewStats& vs) {
+    std::array<raster::QueryResults, 2> results;
+    for (int pass = 0; pass < 2; ++pass) {
+        if (pass == 1) std::reverse(order.begin(), order.end());  // pass 2 runs backward
+        raster::CommandBatch batch(size.width(), size.height());
+        record_pass(batch, g, order, pass, o.mode, vs);
+        if (Status s = device.clear(size.width(), size.height(), o.depth_format); !s) return s.error();
+        Result<raster::QueryResults> r = device.execute(batch);
+        if (!r) return r.error();
+        if (r.value().size() != batch.query_kinds().size())
+            return Error{"device returned " + std::to_string(r.value().size()) + " query results for " +
+                         std::to_string(batch.query_kinds().size()) + " queries"};
+        results[static_cast<std::size_t>(pass)] = std::move(r).value();
+    }
+    std::uint64_t pruned = 0;
+    for (std::size_t i : order) {
+        for (Item& it : g[i].items) {
+            if (it.live && results[0][it.query[0]] == 0 && results[1][it.query[1]] == 0) {
+                it.live = false;
+                ++pruned;
+            }
+        }
+    }
+    return pruned;
+}
+
 // Fits the view and prepares the live objects' geometry for it. Offset mode: widens the depth range
 // until no offset solid reaches past the near or far plane (the offset radius depends on the pixel
 // size, which widening the depth range does not change, and on the depth quantum, which it barely
 // changes, so this settles in one or two steps).
 Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_t>& order, CullStage stage, int axis,
-                    const Aabb& bounds, const CullideOptions& o) {
+                    const Aabb& bounds, const CullideOptions& o, ViewSize size) {
     double extra_depth = 0.0;
     for (int attempt = 0;; ++attempt) {
-        Result<raster::OrthoView> view = make_view(axis, bounds, extra_depth, o);
+        Result<raster::OrthoView> view = make_view(axis, bounds, extra_depth, size, o.depth_format);
         if (!view) return view.error();
         for (std::size_t i : order)
             if (Status s = prepare_geometry(g[i], stage, view.value(), o.mode); !s) return s;
@@ -288,11 +319,8 @@ Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_
 // Views along x, y, z in turn until three views in a row are unproductive (CullideOptions::min_prune;
 // with 0, three views that prune nothing: then the PCS, and so every further view, is unchanged) or
 // 3 * max_rounds views ran.
-Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideOptions& o, QueryDevice& device,
-                 CullideStats& st, raster::VisibilityPass& fused) {
-    const int res = o.resolution;
-    const int emulator_threads = detail::emulator_threads(device);
-    const bool use_fused = o.fused_visibility && o.mode == VisibilityMode::ExactBounds && emulator_threads > 0;
+Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideOptions& o, ViewSize size,
+                 QueryDevice& device, CullideStats& st) {
     const double min_prune =
         o.min_prune >= 0.0 ? o.min_prune : o.mode == VisibilityMode::ExactBounds ? kDefaultMinPruneExactBounds : 0.0;
     int quiet = 0;
@@ -311,55 +339,25 @@ Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideO
             return Status{};
         }
         const int axis = view % 3;
-        if (Status sv = prepare_view(g, order, stage, axis, bounds, o); !sv) return sv;
+        if (Status sv = prepare_view(g, order, stage, axis, bounds, o, size); !sv) return sv;
         ViewStats vs;
         vs.stage = stage;
         vs.axis = axis;
         vs.items_before = count_live(g);
         const std::uint64_t tris_before = count_live_triangles(g);
-        // Unproductive: pruned fewer triangles than min_prune of those live (none pruned: always).
-        const auto unproductive = [&] {
-            const std::uint64_t pruned_tris = tris_before - count_live_triangles(g);
-            return pruned_tris == 0 ||
-                   static_cast<double>(pruned_tris) < min_prune * static_cast<double>(tris_before);
-        };
-        if (use_fused) {
-            Result<std::uint64_t> pruned = fused_view(g, order, o, emulator_threads, fused, vs);
-            if (!pruned) return pruned.error();
-            vs.items_after = vs.items_before - pruned.value();
-            st.queries += vs.queries;
-            st.triangles_rasterized += vs.triangles_rasterized;
-            st.views.push_back(vs);
-            quiet = unproductive() ? quiet + 1 : 0;
-            continue;
-        }
-        std::array<raster::QueryResults, 2> results;
-        for (int pass = 0; pass < 2; ++pass) {
-            if (pass == 1) std::reverse(order.begin(), order.end());  // pass 2 runs backward
-            raster::CommandBatch batch(res, res);
-            record_pass(batch, g, order, pass, o.mode, vs);
-            if (Status s = device.clear(res, res, o.depth_format); !s) return s;
-            Result<raster::QueryResults> r = device.execute(batch);
-            if (!r) return r.error();
-            if (r.value().size() != batch.query_kinds().size())
-                return Error{"device returned " + std::to_string(r.value().size()) + " query results for " +
-                             std::to_string(batch.query_kinds().size()) + " queries"};
-            results[static_cast<std::size_t>(pass)] = std::move(r).value();
-        }
-        std::uint64_t pruned = 0;
-        for (std::size_t i : order) {
-            for (Item& it : g[i].items) {
-                if (it.live && results[0][it.query[0]] == 0 && results[1][it.query[1]] == 0) {
-                    it.live = false;
-                    ++pruned;
-                }
-            }
-        }
-        vs.items_after = vs.items_before - pruned;
+        Result<std::uint64_t> pruned = o.mode == VisibilityMode::ExactBounds
+                                           ? visibility_view(g, order, o, size, device, vs)
+                                           : recorded_view(g, order, o, size, device, vs);
+        if (!pruned) return pruned.error();
+        vs.items_after = vs.items_before - pruned.value();
         st.queries += vs.queries;
         st.triangles_rasterized += vs.triangles_rasterized;
         st.views.push_back(vs);
-        quiet = unproductive() ? quiet + 1 : 0;
+        // Unproductive: pruned fewer triangles than min_prune of those live (none pruned: always).
+        const std::uint64_t pruned_tris = tris_before - count_live_triangles(g);
+        const bool unproductive =
+            pruned_tris == 0 || static_cast<double>(pruned_tris) < min_prune * static_cast<double>(tris_before);
+        quiet = unproductive ? quiet + 1 : 0;
     }
     return Status{};
 }
@@ -370,14 +368,14 @@ std::vector<raster::Double3> to_double3(const Mesh& m) {
     return p;
 }
 
-Status check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active, const CullideOptions& o) {
+Result<ViewSize> check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                              const CullideOptions& o) {
     if (!(o.min_prune < 1.0))  // NaN too
         return Error{"min_prune must be below 1 (negative: the mode's default; got " + std::to_string(o.min_prune) +
                      ")"};
     if (o.object_stage != ObjectStage::Auto && o.object_stage != ObjectStage::On && o.object_stage != ObjectStage::Off)
         return Error{"object_stage is not Auto, On or Off"};
-    return detail::check_visibility_inputs(objects, active, o.resolution, o.subobject_triangles, o.max_rounds,
-                                           o.threads);
+    return detail::check_visibility_inputs(objects, active, o, o.mode);
 }
 
 // The triangles of the surviving sub-objects, paired across objects and tested exactly: each live
@@ -419,13 +417,11 @@ const char* to_string(CullStage s) {
 Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
                                                 const CullideOptions& options, QueryDevice& device,
                                                 CullideStats* stats) {
-    if (Status s = check_inputs(objects, active, options); !s) return s.error();
+    Result<ViewSize> checked = check_inputs(objects, active, options);
+    if (!checked) return checked.error();
+    const ViewSize size = checked.value();
     CullideStats st;
     st.objects_in = active.size();
-    // Reused by every view of the frame and, per calling thread, by later frames: its buffers then
-    // stop growing after the first frame (no fresh pages to fault in per frame). It keeps no answer
-    // from one call to the next, so results cannot depend on what ran before.
-    thread_local raster::VisibilityPass fused;
 
     // Stage 1: object boxes.
     auto t0 = Clock::now();
@@ -440,7 +436,7 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
         og.indices.assign(kBoxIndices.begin(), kBoxIndices.end());
         og.items.push_back({0, 36, b, true, {}});
     }
-    if (Status s = run_stage(boxes, CullStage::Boxes, options, device, st, fused); !s) return s.error();
+    if (Status s = run_stage(boxes, CullStage::Boxes, options, size, device, st); !s) return s.error();
     st.pcs_boxes = count_live(boxes);
     st.boxes_ms = ms_since(t0);
 
@@ -461,7 +457,7 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
     const bool object_stage = options.object_stage == ObjectStage::On ||
                               (options.object_stage == ObjectStage::Auto && options.mode != VisibilityMode::ExactBounds);
     if (object_stage)
-        if (Status s = run_stage(whole, CullStage::Objects, options, device, st, fused); !s) return s.error();
+        if (Status s = run_stage(whole, CullStage::Objects, options, size, device, st); !s) return s.error();
     st.pcs_objects = count_live(whole);
     st.objects_ms = ms_since(t0);
 
@@ -486,7 +482,7 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
         st.subobjects += og.items.size();
         subs.push_back(std::move(og));
     }
-    if (Status s = run_stage(subs, CullStage::SubObjects, options, device, st, fused); !s) return s.error();
+    if (Status s = run_stage(subs, CullStage::SubObjects, options, size, device, st); !s) return s.error();
     st.pcs_subobjects = count_live(subs);
     st.subobjects_ms = ms_since(t0);
 
@@ -502,17 +498,16 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
 
 namespace cullide::detail {
 
-Status check_visibility_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active, int resolution,
-                               int subobject_triangles, int max_rounds, int threads) {
-    if (resolution < 1 || resolution > raster::kMaxTargetSize)
-        return Error{"resolution must be in 1.." + std::to_string(raster::kMaxTargetSize) + " (got " +
-                     std::to_string(resolution) + ")"};
-    if (subobject_triangles < 1)
-        return Error{"sub-object size must be >= 1 triangle (got " + std::to_string(subobject_triangles) + ")"};
-    if (max_rounds < 1 || max_rounds > 1000)
-        return Error{"max_rounds must be in 1..1000 (got " + std::to_string(max_rounds) + ")"};
-    if (threads < 0) return Error{"threads must be >= 0 (got " + std::to_string(threads) + ")"};
-    if (Status s = validate_scene(objects); !s) return s;
+Result<ViewSize> check_visibility_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                                         const VisibilityOptions& o, VisibilityMode mode) {
+    Result<ViewSize> size = view_size(o.resolution, mode);
+    if (!size) return size.error();
+    if (o.subobject_triangles < 1)
+        return Error{"sub-object size must be >= 1 triangle (got " + std::to_string(o.subobject_triangles) + ")"};
+    if (o.max_rounds < 1 || o.max_rounds > 1000)
+        return Error{"max_rounds must be in 1..1000 (got " + std::to_string(o.max_rounds) + ")"};
+    if (o.threads < 0) return Error{"threads must be >= 0 (got " + std::to_string(o.threads) + ")"};
+    if (Status s = validate_scene(objects); !s) return s.error();
     if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
     for (std::size_t k = 0; k < active.size(); ++k) {
         if (active[k] >= objects.size())
@@ -535,7 +530,7 @@ Status check_visibility_inputs(std::span<const Mesh> objects, std::span<const st
             }
         }
     }
-    return Status{};
+    return size;
 }
 
 }  // namespace cullide::detail

@@ -54,11 +54,11 @@ struct Item {
     std::uint32_t query = 0;
 };
 
-Status check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active, const QuickOptions& o) {
+Result<ViewSize> check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                              const QuickOptions& o) {
     if (o.mode == VisibilityMode::Offset)
         return Error{"Quick-CULLIDE runs in GL-exact or exact-bounds mode, not with offset solids"};
-    return detail::check_visibility_inputs(objects, active, o.resolution, o.subobject_triangles, o.max_rounds,
-                                           o.threads);
+    return detail::check_visibility_inputs(objects, active, o, o.mode);
 }
 
 std::uint64_t count_live(const std::vector<Item>& items) {
@@ -80,9 +80,9 @@ std::uint64_t record_draw(raster::CommandBatch& batch, const Geom& g, const Item
     return it.count;
 }
 
-Status run_device(QueryDevice& device, const raster::CommandBatch& batch, const QuickOptions& o,
+Status run_device(QueryDevice& device, const raster::CommandBatch& batch, ViewSize size, raster::DepthFormat format,
                   raster::QueryResults& out) {
-    if (Status s = device.clear(o.resolution, o.resolution, o.depth_format); !s) return s;
+    if (Status s = device.clear(size.width(), size.height(), format); !s) return s;
     Result<raster::QueryResults> r = device.execute(batch);
     if (!r) return r.error();
     if (r.value().size() != batch.query_kinds().size())
@@ -97,11 +97,8 @@ Status run_device(QueryDevice& device, const raster::CommandBatch& batch, const 
 // Pass 1 draws item j right after the query of item near_hi[j] (pass 2: near_lo[j]); both are
 // non-decreasing in j, so one cursor per pass schedules every deferred draw.
 Status run_stage(std::vector<Geom>& geoms, std::vector<Item>& items, CullStage stage, const QuickOptions& o,
-                 QueryDevice& device, QuickStats& st) {
+                 ViewSize size, QueryDevice& device, QuickStats& st) {
     if (o.skip_visibility) return Status{};
-    CullideOptions co;
-    co.resolution = o.resolution;
-    co.depth_format = o.depth_format;
     const std::size_t n = items.size();
     int quiet = 0;
     int first_axis = -1;  // the thinnest axis of the stage's first live bounds (see below)
@@ -124,7 +121,7 @@ Status run_stage(std::vector<Geom>& geoms, std::vector<Item>& items, CullStage s
                 if (bounds.hi[k] - bounds.lo[k] < bounds.hi[first_axis] - bounds.lo[first_axis]) first_axis = k;
         }
         const int axis = (first_axis + view) % 3;
-        Result<raster::OrthoView> v = detail::make_view(axis, bounds, 0.0, co);
+        Result<raster::OrthoView> v = detail::make_view(axis, bounds, 0.0, size, o.depth_format);
         if (!v) return v.error();
         for (std::size_t gi = 0; gi < geoms.size(); ++gi) {
             if (!geom_live[gi]) continue;
@@ -149,7 +146,7 @@ Status run_stage(std::vector<Geom>& geoms, std::vector<Item>& items, CullStage s
         raster::QueryResults res;
         // Pass 1, forward.
         {
-            raster::CommandBatch batch(o.resolution, o.resolution);
+            raster::CommandBatch batch(size.width(), size.height());
             std::size_t r = 0;
             for (std::size_t k = 0; k < n; ++k) {
                 Item& it = items[k];
@@ -164,7 +161,7 @@ Status run_stage(std::vector<Geom>& geoms, std::vector<Item>& items, CullStage s
                     if (!(items[r].tag & kSFV))
                         vs.triangles_rasterized += record_draw(batch, geoms[items[r].geom], items[r], o.mode, false);
             }
-            if (Status s = run_device(device, batch, o, res); !s) return s;
+            if (Status s = run_device(device, batch, size, o.depth_format, res); !s) return s;
             for (Item& it : items) {
                 if (!(it.tag & kFFV) && res[it.query] == 0) {
                     it.tag |= kFFV;
@@ -174,7 +171,7 @@ Status run_stage(std::vector<Geom>& geoms, std::vector<Item>& items, CullStage s
         }
         // Pass 2, backward.
         {
-            raster::CommandBatch batch(o.resolution, o.resolution);
+            raster::CommandBatch batch(size.width(), size.height());
             std::size_t r = n;  // items [r, n) are scheduled
             for (std::size_t k = n; k-- > 0;) {
                 Item& it = items[k];
@@ -190,7 +187,7 @@ Status run_stage(std::vector<Geom>& geoms, std::vector<Item>& items, CullStage s
                         vs.triangles_rasterized +=
                             record_draw(batch, geoms[items[r - 1].geom], items[r - 1], o.mode, false);
             }
-            if (Status s = run_device(device, batch, o, res); !s) return s;
+            if (Status s = run_device(device, batch, size, o.depth_format, res); !s) return s;
             for (Item& it : items) {
                 if (!(it.tag & kSFV) && res[it.query] == 0) {
                     it.tag |= kSFV;
@@ -402,7 +399,9 @@ Result<std::vector<TrianglePair>> quick_cullide_pairs(std::span<const Mesh> obje
                                                       std::span<const std::uint32_t> active,
                                                       const QuickOptions& options, QueryDevice& device,
                                                       QuickStats* stats) {
-    if (Status s = check_inputs(objects, active, options); !s) return s.error();
+    Result<ViewSize> checked = check_inputs(objects, active, options);
+    if (!checked) return checked.error();
+    const ViewSize size = checked.value();
     QuickStats st;
     st.objects_in = active.size();
     const auto group = static_cast<std::size_t>(options.subobject_triangles);
@@ -429,7 +428,7 @@ Result<std::vector<TrianglePair>> quick_cullide_pairs(std::span<const Mesh> obje
             box_items[k].box = b;
         }
         set_object_near(box_items);
-        if (Status s = run_stage(boxes, box_items, CullStage::Boxes, options, device, st); !s) return s.error();
+        if (Status s = run_stage(boxes, box_items, CullStage::Boxes, options, size, device, st); !s) return s.error();
         st.pcs_boxes = count_live(box_items);
         st.boxes_ms = ms_since(t0);
 
@@ -451,7 +450,7 @@ Result<std::vector<TrianglePair>> quick_cullide_pairs(std::span<const Mesh> obje
             items.push_back(it);
         }
         set_object_near(items);
-        if (Status s = run_stage(geoms, items, CullStage::Objects, options, device, st); !s) return s.error();
+        if (Status s = run_stage(geoms, items, CullStage::Objects, options, size, device, st); !s) return s.error();
         st.pcs_objects = count_live(items);
         st.objects_ms = ms_since(t0);
 
@@ -460,13 +459,13 @@ Result<std::vector<TrianglePair>> quick_cullide_pairs(std::span<const Mesh> obje
         items = split_items(geoms, items, group);
         set_object_near(items);
         st.subobjects = items.size();
-        if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, device, st); !s) return s.error();
+        if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, size, device, st); !s) return s.error();
         st.pcs_subobjects = count_live(items);
         if (group > 1) {
             items = split_items(geoms, items, 1);
             set_object_near(items);
             st.triangles_in = items.size();
-            if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, device, st); !s) return s.error();
+            if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, size, device, st); !s) return s.error();
             st.pcs_triangles = count_live(items);
         }
         st.subobjects_ms = ms_since(t0);
@@ -509,7 +508,7 @@ Result<std::vector<TrianglePair>> quick_cullide_pairs(std::span<const Mesh> obje
         overlapping = box_pairs(items, true, options.threads);
         if (!options.skip_visibility) box_tags(items, overlapping);
         st.pcs_boxes = count_live(items);
-        if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, device, st); !s) return s.error();
+        if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, size, device, st); !s) return s.error();
         st.pcs_subobjects = count_live(items);
         st.subobjects_ms = ms_since(t0);
     }
