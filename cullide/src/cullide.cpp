@@ -414,17 +414,10 @@ const char* to_string(CullStage s) {
     return "?";
 }
 
-Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
-                                                const CullideOptions& options, QueryDevice& device,
-                                                CullideStats* stats) {
-    Result<ViewSize> checked = check_inputs(objects, active, options);
-    if (!checked) return checked.error();
-    const ViewSize size = checked.value();
-    CullideStats st;
-    st.objects_in = active.size();
+namespace {
 
-    // Stage 1: object boxes.
-    auto t0 = Clock::now();
+// Stage 1's geometry: each active object's box as one item of 12 triangles.
+std::vector<ObjectGeometry> box_geometry(std::span<const Mesh> objects, std::span<const std::uint32_t> active) {
     std::vector<ObjectGeometry> boxes(active.size());
     for (std::size_t k = 0; k < active.size(); ++k) {
         ObjectGeometry& og = boxes[k];
@@ -436,12 +429,12 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
         og.indices.assign(kBoxIndices.begin(), kBoxIndices.end());
         og.items.push_back({0, 36, b, true, {}});
     }
-    if (Status s = run_stage(boxes, CullStage::Boxes, options, size, device, st); !s) return s.error();
-    st.pcs_boxes = count_live(boxes);
-    st.boxes_ms = ms_since(t0);
+    return boxes;
+}
 
-    // Stage 2: whole objects.
-    t0 = Clock::now();
+// Stage 2's geometry: the mesh of each object whose box survived, as one item.
+std::vector<ObjectGeometry> object_geometry(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                                            const std::vector<ObjectGeometry>& boxes) {
     std::vector<ObjectGeometry> whole;
     for (const ObjectGeometry& b : boxes) {
         if (!b.items[0].live) continue;
@@ -454,18 +447,15 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
         og.items.push_back({0, static_cast<std::uint32_t>(og.indices.size()), b.items[0].box, true, {}});
         whole.push_back(std::move(og));
     }
-    const bool object_stage = options.object_stage == ObjectStage::On ||
-                              (options.object_stage == ObjectStage::Auto && options.mode != VisibilityMode::ExactBounds);
-    if (object_stage)
-        if (Status s = run_stage(whole, CullStage::Objects, options, size, device, st); !s) return s.error();
-    st.pcs_objects = count_live(whole);
-    st.objects_ms = ms_since(t0);
+    return whole;
+}
 
-    // Stage 3: sub-objects of consecutive triangles (neighbours in meshes stored strip- or
-    // patch-wise; see docs/cullide.md for what this choice costs on scrambled meshes).
-    t0 = Clock::now();
+// Stage 3's geometry: each surviving object split into sub-objects of `group` consecutive triangles
+// (neighbours in meshes stored strip- or patch-wise; see docs/cullide.md for what this choice costs
+// on scrambled meshes), with its triangles' boxes for the exact stage.
+std::vector<ObjectGeometry> subobject_geometry(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                                               std::vector<ObjectGeometry>&& whole, std::size_t group) {
     std::vector<ObjectGeometry> subs;
-    const auto group = static_cast<std::size_t>(options.subobject_triangles);
     for (ObjectGeometry& og : whole) {
         if (!og.items[0].live) continue;
         const Mesh& m = objects[active[og.active_index]];
@@ -479,14 +469,45 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
             og.items.push_back(
                 {static_cast<std::uint32_t>(first * 3), static_cast<std::uint32_t>((last - first) * 3), b, true, {}});
         }
-        st.subobjects += og.items.size();
         subs.push_back(std::move(og));
     }
+    return subs;
+}
+
+}  // namespace
+
+Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                                                const CullideOptions& options, QueryDevice& device,
+                                                CullideStats* stats) {
+    Result<ViewSize> checked = check_inputs(objects, active, options);
+    if (!checked) return checked.error();
+    const ViewSize size = checked.value();
+    CullideStats st;
+    st.objects_in = active.size();
+
+    auto t0 = Clock::now();
+    std::vector<ObjectGeometry> boxes = box_geometry(objects, active);
+    if (Status s = run_stage(boxes, CullStage::Boxes, options, size, device, st); !s) return s.error();
+    st.pcs_boxes = count_live(boxes);
+    st.boxes_ms = ms_since(t0);
+
+    t0 = Clock::now();
+    std::vector<ObjectGeometry> whole = object_geometry(objects, active, boxes);
+    const bool object_stage = options.object_stage == ObjectStage::On ||
+                              (options.object_stage == ObjectStage::Auto && options.mode != VisibilityMode::ExactBounds);
+    if (object_stage)
+        if (Status s = run_stage(whole, CullStage::Objects, options, size, device, st); !s) return s.error();
+    st.pcs_objects = count_live(whole);
+    st.objects_ms = ms_since(t0);
+
+    t0 = Clock::now();
+    std::vector<ObjectGeometry> subs =
+        subobject_geometry(objects, active, std::move(whole), static_cast<std::size_t>(options.subobject_triangles));
+    for (const ObjectGeometry& og : subs) st.subobjects += og.items.size();
     if (Status s = run_stage(subs, CullStage::SubObjects, options, size, device, st); !s) return s.error();
     st.pcs_subobjects = count_live(subs);
     st.subobjects_ms = ms_since(t0);
 
-    // Stage 4: exact.
     t0 = Clock::now();
     std::vector<TrianglePair> pairs = exact_stage(objects, active, subs, options.threads, st);
     st.exact_ms = ms_since(t0);
