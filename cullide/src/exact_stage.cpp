@@ -170,7 +170,9 @@ class TaskBuilder {
         if (task.refs.size() < 2 && (common != nullptr || task.refs.empty() || sets_[task.refs[0].set].count < 2))
             return;
         task.axis = spread_axis(task.refs);
-        if (common == nullptr || loose(task.refs, task.axis)) {
+        const bool all_triangles = std::all_of(task.refs.begin(), task.refs.end(),
+                                               [](const SweepRef& r) { return r.part != kWholeSet; });
+        if (!all_triangles && (common == nullptr || loose(task.refs, task.axis))) {
             std::vector<SweepRef> tris;
             for (const SweepRef& r : task.refs) {
                 const CandidateSet& set = sets_[r.set];
@@ -238,7 +240,7 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> overlapping_sets(std::vecto
     const std::size_t units = (refs.size() + kSweepChunk - 1) / kSweepChunk;
     std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> found(units);
     parallel_chunks(threads, units, [&](std::size_t u) {
-        sweep_overlaps(refs, axis, u * kSweepChunk, std::min(refs.size(), (u + 1) * kSweepChunk),
+        sweep_overlaps(refs, axis, u * kSweepChunk, std::min(refs.size(), (u + 1) * kSweepChunk), true,
                        [&](const SweepRef& a, const SweepRef& b) {
                            found[u].emplace_back(std::min(a.set, b.set), std::max(a.set, b.set));
                        });
@@ -273,8 +275,7 @@ ExactStageResult sweep_exact_stage(std::span<const ExactObject> objects, std::sp
     parallel_chunks(options.threads, units.size(), [&](std::size_t u) {
         const Task& task = tasks[units[u].task];
         UnitOut& o = out[u];
-        sweep_overlaps(task.refs, task.axis, units[u].begin, units[u].end, [&](const SweepRef& a, const SweepRef& b) {
-            if (a.object == b.object && !task.self) return;
+        const auto visit = [&](const SweepRef& a, const SweepRef& b) {
             if (a.part != kWholeSet && b.part != kWholeSet) {  // two triangles, boxes overlapping
                 if (tester.test(a.object, a.part, b.object, b.part, false, o) && options.count_set_pairs)
                     o.set_pairs.push_back(set_pair_key(a.set, b.set));
@@ -282,7 +283,8 @@ ExactStageResult sweep_exact_stage(std::span<const ExactObject> objects, std::sp
             }
             if (tester.test_sets(a.set, b.set, false, o) != 0 && options.count_set_pairs)
                 o.set_pairs.push_back(set_pair_key(a.set, b.set));
-        });
+        };
+        sweep_overlaps(task.refs, task.axis, units[u].begin, units[u].end, task.self, visit);
     });
     ExactStageResult r = merge(out, options.count_set_pairs);
     r.stats.task_triangles = builder.task_triangles();

@@ -44,13 +44,19 @@ struct SweepRef {
 void sort_along(std::vector<SweepRef>& refs, int axis);
 
 // Calls visit(refs[i], refs[j]) for every i in [begin, end) and j > i whose boxes overlap, `refs`
-// sorted by sort_along(axis). Any [begin, end) split of the list visits each pair once.
+// sorted by sort_along(axis); refs of one object only when `same_object`. Any [begin, end) split of
+// the list visits each pair once. The object test comes before the box test: it is one integer
+// compare, and in a task of two objects half the refs the sweep meets are the same object's.
 template <class Visit>
-void sweep_overlaps(std::span<const SweepRef> refs, int axis, std::size_t begin, std::size_t end, Visit&& visit) {
+void sweep_overlaps(std::span<const SweepRef> refs, int axis, std::size_t begin, std::size_t end, bool same_object,
+                    Visit&& visit) {
     for (std::size_t i = begin; i < end; ++i) {
-        const Aabb& a = refs[i].box;
-        for (std::size_t j = i + 1; j < refs.size() && refs[j].box.lo[axis] <= a.hi[axis]; ++j)
-            if (overlaps(a, refs[j].box)) visit(refs[i], refs[j]);
+        const SweepRef& a = refs[i];
+        const double a_hi = a.box.hi[axis];
+        for (std::size_t j = i + 1; j < refs.size() && refs[j].box.lo[axis] <= a_hi; ++j) {
+            if (!same_object && refs[j].object == a.object) continue;
+            if (overlaps(a.box, refs[j].box)) visit(a, refs[j]);
+        }
     }
 }
 
@@ -67,7 +73,9 @@ struct ExactObject {
     const Mesh* mesh = nullptr;
     std::uint32_t object = 0;              // reported in the pairs (index into the caller's objects)
     Aabb box;                              // holds every set of the object (sweep_exact_stage's tasks)
-    std::span<const Aabb> triangle_boxes;  // by position
+    std::span<const Aabb> triangle_boxes;  // by position; sweep_exact_stage never reads it when every
+                                           // set of the object holds one triangle (the set's box is
+                                           // the triangle's), so it may be empty then
     std::span<const std::uint32_t> order;  // mesh triangle by position; empty: the identity
     std::span<const std::uint32_t> weld;   // welded vertex ids (weld_vertices); needed for self pairs
 };

@@ -78,24 +78,23 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
     if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
     if (Status s = validate_exact_range(objects); !s) return s.error();
 
-    // Every triangle is a candidate set of its own: the exact stage sweeps them per pair of objects
-    // whose boxes overlap (and per object with self-collision).
+    // Every triangle is a candidate set of its own (so the exact stage needs no separate list of
+    // triangle boxes): it sweeps them per pair of objects whose boxes overlap (and per object with
+    // self-collision).
     const std::size_t n = objects.size();
-    std::vector<std::vector<Aabb>> triangle_boxes(n);
     std::vector<std::vector<std::uint32_t>> welded(options.self ? n : 0);
     std::vector<detail::ExactObject> exact(n);
     std::vector<detail::CandidateSet> sets;
     ExactStats st;
+    for (const Mesh& m : objects) st.triangles += m.triangles.size();
+    sets.reserve(st.triangles);
     for (std::size_t i = 0; i < n; ++i) {
         const Mesh& m = objects[i];
-        st.triangles += m.triangles.size();
-        triangle_boxes[i].resize(m.triangles.size());
-        for (std::size_t t = 0; t < m.triangles.size(); ++t) {
-            triangle_boxes[i][t] = triangle_bounds(m, t);
-            sets.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(t), 1, triangle_boxes[i][t]});
-        }
+        const auto object = static_cast<std::uint32_t>(i);
+        for (std::size_t t = 0; t < m.triangles.size(); ++t)
+            sets.push_back({object, static_cast<std::uint32_t>(t), 1, triangle_bounds(m, t)});
         if (options.self) welded[i] = weld_vertices(m);
-        exact[i] = {&m, static_cast<std::uint32_t>(i), mesh_bounds(m), triangle_boxes[i], {},
+        exact[i] = {&m, object, mesh_bounds(m), {}, {},
                     options.self ? std::span<const std::uint32_t>(welded[i]) : std::span<const std::uint32_t>()};
     }
     detail::ExactStageResult r = detail::sweep_exact_stage(exact, sets, {options.self, false, options.threads});
