@@ -400,22 +400,6 @@ std::vector<TrianglePair> exact_stage(std::span<const Mesh> objects, std::span<c
     return std::move(r.pairs);
 }
 
-}  // namespace
-
-const char* to_string(CullStage s) {
-    switch (s) {
-        case CullStage::Boxes:
-            return "boxes";
-        case CullStage::Objects:
-            return "objects";
-        case CullStage::SubObjects:
-            return "subobjects";
-    }
-    return "?";
-}
-
-namespace {
-
 // Stage 1's geometry: each active object's box as one item of 12 triangles.
 std::vector<ObjectGeometry> box_geometry(std::span<const Mesh> objects, std::span<const std::uint32_t> active) {
     std::vector<ObjectGeometry> boxes(active.size());

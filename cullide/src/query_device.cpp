@@ -1,19 +1,11 @@
 // query_device.cpp: what every QueryDevice can do through clear and execute (the recorded
-// visibility pass), and the view size every device is handed (visibility.h).
+// visibility pass).
 #include "cullide/query_device.h"
 
 #include <string>
 #include <utility>
 
 namespace cullide {
-
-Result<ViewSize> view_size(int requested, VisibilityMode mode) {
-    const int pixels = requested == 0 ? default_resolution(mode) : requested;
-    if (pixels < kMinViewResolution || pixels > kMaxViewResolution)
-        return Error{"resolution must be in " + std::to_string(kMinViewResolution) + ".." +
-                     std::to_string(kMaxViewResolution) + " (got " + std::to_string(requested) + ")"};
-    return ViewSize(pixels);
-}
 
 Result<std::vector<std::uint8_t>> QueryDevice::visibility_pass(ViewSize size, raster::DepthFormat format,
                                                                std::span<const raster::VisibilityItem> items) {

@@ -19,7 +19,10 @@
 //  4. exact: per pair of objects whose live boxes overlap, the live sub-objects meeting the two
 //     boxes' intersection swept and pruned on their boxes (or on their triangles' boxes when the
 //     sub-object boxes are loose), then the triangle pairs whose boxes overlap, then the exact test
-//     of tri_tri.h.
+//     of tri_tri.h: the exact stage every method shares (the ground truth included), with the live
+//     sub-objects as its candidate sets.
+// Views run on a QueryDevice (query_device.h): GLExact and Offset record each pass as a command
+// batch; ExactBounds hands both passes of a view to QueryDevice::visibility_pass at once.
 // Pass k of a view: clear depth; for each live object in order (pass 1) or reverse order (pass 2):
 // query its live items (GEQUAL, depth mask off, one any-samples query each), then write them
 // (LEQUAL, mask on). An item whose queries pass no sample in both passes is fully visible with
