@@ -98,12 +98,8 @@ ObjectStage object_stage_value(const OptionSpec& spec, const std::string& v) {
 }
 
 std::string resolution_default() {
-    const std::string others = ", " + std::to_string(kDefaultResolutionOthers) + " for the others";
-    if (kDefaultResolutionRCullide == kDefaultResolutionQCullide) {
-        return std::to_string(kDefaultResolutionRCullide) + " for rcullide and qcullide" + others;
-    }
-    return std::to_string(kDefaultResolutionRCullide) + " for rcullide, " +
-           std::to_string(kDefaultResolutionQCullide) + " for qcullide" + others;
+    return std::to_string(default_resolution(Method::RCullide)) + " for rcullide and qcullide (exact bounds), " +
+           std::to_string(default_resolution(Method::Cullide)) + " for the others";
 }
 
 std::string min_prune_default() {
@@ -215,7 +211,7 @@ void add_run_options(std::vector<OptionSpec>& t) {
                      s.pipeline.threads = int_value(o, v);
                  }});
     t.push_back({"--resolution", "R", kRunOnly, "view resolution of visibility methods",
-                 integers(kMinCliResolution, raster::kMaxTargetSize), resolution_default(), "",
+                 integers(kMinCliResolution, kMaxViewResolution), resolution_default(), "",
                  [](const OptionSpec& o, const std::string& v, Settings& s) {
                      s.pipeline.resolution = int_value(o, v);
                  }});
@@ -303,7 +299,7 @@ void add_bench_options(std::vector<OptionSpec>& t) {
                  true});
     t.push_back({"--resolutions", "LIST", kBenchSweep,
                  "view resolutions; bench without it runs each method at its own: " + resolution_default(),
-                 integers(kMinCliResolution, raster::kMaxTargetSize), "", "32,64,128,256,512,1024",
+                 integers(kMinCliResolution, kMaxViewResolution), "", "32,64,128,256,512,1024",
                  [](const OptionSpec& o, const std::string& v, Settings& s) {
                      s.resolutions.clear();
                      for (const std::string& item : list_items(o, v))

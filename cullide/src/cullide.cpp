@@ -9,9 +9,8 @@
 #include <string>
 
 #include "cullide/predicates.h"
-#include "cullide/tri_tri.h"
 #include "cullide_detail.h"
-#include "emulator_device.h"
+#include "exact_stage.h"
 #include "parallel.h"
 #include "raster/command_batch.h"
 #include "raster/offset_geometry.h"
@@ -90,7 +89,8 @@ void widen(double& lo, double& hi) {
 // The orthographic view along `axis` (raster::OrthoView: window axes are the next two in cyclic
 // order, depth grows along the axis) fitted to `bounds` widened as above, with `extra_depth` more
 // world units before and after along the axis (Offset mode).
-Result<raster::OrthoView> make_view(int axis, const Aabb& bounds, double extra_depth, const CullideOptions& o) {
+Result<raster::OrthoView> make_view(int axis, const Aabb& bounds, double extra_depth, ViewSize size,
+                                    raster::DepthFormat format) {
     std::array<double, 3> lo{bounds.lo.x, bounds.lo.y, bounds.lo.z};
     std::array<double, 3> hi{bounds.hi.x, bounds.hi.y, bounds.hi.z};
     for (std::size_t k = 0; k < 3; ++k) {
@@ -104,7 +104,7 @@ Result<raster::OrthoView> make_view(int axis, const Aabb& bounds, double extra_d
     }
     raster::Result<raster::OrthoView> v =
         raster::make_ortho_view(static_cast<raster::Axis>(axis), {lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]},
-                                o.resolution, o.resolution, o.depth_format);
+                                size.width(), size.height(), format);
     if (!v) return Error{"view: " + v.error().message};
     return v.value();
 }
@@ -228,10 +228,11 @@ void count_passes(const std::vector<ObjectGeometry>& g, const std::vector<std::s
     }
 }
 
-// Both passes of one view at once on the emulator (raster/visibility.h); prunes the fully visible
-// items. Same answers as recording them (tests/cullide/fused_visibility_test.cpp compares the two).
-Result<std::uint64_t> fused_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_t>& order,
-                                 const CullideOptions& o, int threads, raster::VisibilityPass& pass, ViewStats& vs) {
+// Both passes of one exact-bounds view as the device's visibility pass (query_device.h); prunes
+// the fully visible items. The fused and the recorded form give the same answers
+// (tests/cullide/fused_visibility_test.cpp compares the two).
+Result<std::uint64_t> visibility_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_t>& order,
+                                      const CullideOptions& o, ViewSize size, QueryDevice& device, ViewStats& vs) {
     std::vector<raster::VisibilityItem> items;
     std::vector<Item*> refs;
     for (std::size_t k = 0; k < order.size(); ++k) {
@@ -245,9 +246,10 @@ Result<std::uint64_t> fused_view(std::vector<ObjectGeometry>& g, const std::vect
         }
     }
     count_passes(g, order, vs);
-    raster::Result<std::vector<std::uint8_t>> r =
-        pass.run(o.resolution, o.resolution, o.depth_format, items, threads);
-    if (!r) return Error{"emulator device: " + r.error().message};
+    Result<std::vector<std::uint8_t>> r = o.fused_visibility
+                                              ? device.visibility_pass(size, o.depth_format, items)
+                                              : device.recorded_visibility_pass(size, o.depth_format, items);
+    if (!r) return r.error();
     std::uint64_t pruned = 0;
     for (std::size_t i = 0; i < refs.size(); ++i) {
         if (r.value()[i] == 0) {
@@ -258,15 +260,44 @@ Result<std::uint64_t> fused_view(std::vector<ObjectGeometry>& g, const std::vect
     return pruned;
 }
 
+// Both passes of one GL-exact or offset view, recorded and run on the device; prunes the fully
+// visible items.
+Result<std::uint64_t> recorded_view(std::vector<ObjectGeometry>& g, std::vector<std::size_t> order,
+                                    const CullideOptions& o, ViewSize size, QueryDevice& device, ViewStats& vs) {
+    std::array<raster::QueryResults, 2> results;
+    for (int pass = 0; pass < 2; ++pass) {
+        if (pass == 1) std::reverse(order.begin(), order.end());  // pass 2 runs backward
+        raster::CommandBatch batch(size.width(), size.height());
+        record_pass(batch, g, order, pass, o.mode, vs);
+        if (Status s = device.clear(size.width(), size.height(), o.depth_format); !s) return s.error();
+        Result<raster::QueryResults> r = device.execute(batch);
+        if (!r) return r.error();
+        if (r.value().size() != batch.query_kinds().size())
+            return Error{"device returned " + std::to_string(r.value().size()) + " query results for " +
+                         std::to_string(batch.query_kinds().size()) + " queries"};
+        results[static_cast<std::size_t>(pass)] = std::move(r).value();
+    }
+    std::uint64_t pruned = 0;
+    for (std::size_t i : order) {
+        for (Item& it : g[i].items) {
+            if (it.live && results[0][it.query[0]] == 0 && results[1][it.query[1]] == 0) {
+                it.live = false;
+                ++pruned;
+            }
+        }
+    }
+    return pruned;
+}
+
 // Fits the view and prepares the live objects' geometry for it. Offset mode: widens the depth range
 // until no offset solid reaches past the near or far plane (the offset radius depends on the pixel
 // size, which widening the depth range does not change, and on the depth quantum, which it barely
 // changes, so this settles in one or two steps).
 Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_t>& order, CullStage stage, int axis,
-                    const Aabb& bounds, const CullideOptions& o) {
+                    const Aabb& bounds, const CullideOptions& o, ViewSize size) {
     double extra_depth = 0.0;
     for (int attempt = 0;; ++attempt) {
-        Result<raster::OrthoView> view = make_view(axis, bounds, extra_depth, o);
+        Result<raster::OrthoView> view = make_view(axis, bounds, extra_depth, size, o.depth_format);
         if (!view) return view.error();
         for (std::size_t i : order)
             if (Status s = prepare_geometry(g[i], stage, view.value(), o.mode); !s) return s;
@@ -288,11 +319,8 @@ Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_
 // Views along x, y, z in turn until three views in a row are unproductive (CullideOptions::min_prune;
 // with 0, three views that prune nothing: then the PCS, and so every further view, is unchanged) or
 // 3 * max_rounds views ran.
-Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideOptions& o, QueryDevice& device,
-                 CullideStats& st, raster::VisibilityPass& fused) {
-    const int res = o.resolution;
-    const int emulator_threads = detail::emulator_threads(device);
-    const bool use_fused = o.fused_visibility && o.mode == VisibilityMode::ExactBounds && emulator_threads > 0;
+Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideOptions& o, ViewSize size,
+                 QueryDevice& device, CullideStats& st) {
     const double min_prune =
         o.min_prune >= 0.0 ? o.min_prune : o.mode == VisibilityMode::ExactBounds ? kDefaultMinPruneExactBounds : 0.0;
     int quiet = 0;
@@ -311,55 +339,25 @@ Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideO
             return Status{};
         }
         const int axis = view % 3;
-        if (Status sv = prepare_view(g, order, stage, axis, bounds, o); !sv) return sv;
+        if (Status sv = prepare_view(g, order, stage, axis, bounds, o, size); !sv) return sv;
         ViewStats vs;
         vs.stage = stage;
         vs.axis = axis;
         vs.items_before = count_live(g);
         const std::uint64_t tris_before = count_live_triangles(g);
-        // Unproductive: pruned fewer triangles than min_prune of those live (none pruned: always).
-        const auto unproductive = [&] {
-            const std::uint64_t pruned_tris = tris_before - count_live_triangles(g);
-            return pruned_tris == 0 ||
-                   static_cast<double>(pruned_tris) < min_prune * static_cast<double>(tris_before);
-        };
-        if (use_fused) {
-            Result<std::uint64_t> pruned = fused_view(g, order, o, emulator_threads, fused, vs);
-            if (!pruned) return pruned.error();
-            vs.items_after = vs.items_before - pruned.value();
-            st.queries += vs.queries;
-            st.triangles_rasterized += vs.triangles_rasterized;
-            st.views.push_back(vs);
-            quiet = unproductive() ? quiet + 1 : 0;
-            continue;
-        }
-        std::array<raster::QueryResults, 2> results;
-        for (int pass = 0; pass < 2; ++pass) {
-            if (pass == 1) std::reverse(order.begin(), order.end());  // pass 2 runs backward
-            raster::CommandBatch batch(res, res);
-            record_pass(batch, g, order, pass, o.mode, vs);
-            if (Status s = device.clear(res, res, o.depth_format); !s) return s;
-            Result<raster::QueryResults> r = device.execute(batch);
-            if (!r) return r.error();
-            if (r.value().size() != batch.query_kinds().size())
-                return Error{"device returned " + std::to_string(r.value().size()) + " query results for " +
-                             std::to_string(batch.query_kinds().size()) + " queries"};
-            results[static_cast<std::size_t>(pass)] = std::move(r).value();
-        }
-        std::uint64_t pruned = 0;
-        for (std::size_t i : order) {
-            for (Item& it : g[i].items) {
-                if (it.live && results[0][it.query[0]] == 0 && results[1][it.query[1]] == 0) {
-                    it.live = false;
-                    ++pruned;
-                }
-            }
-        }
-        vs.items_after = vs.items_before - pruned;
+        Result<std::uint64_t> pruned = o.mode == VisibilityMode::ExactBounds
+                                           ? visibility_view(g, order, o, size, device, vs)
+                                           : recorded_view(g, order, o, size, device, vs);
+        if (!pruned) return pruned.error();
+        vs.items_after = vs.items_before - pruned.value();
         st.queries += vs.queries;
         st.triangles_rasterized += vs.triangles_rasterized;
         st.views.push_back(vs);
-        quiet = unproductive() ? quiet + 1 : 0;
+        // Unproductive: pruned fewer triangles than min_prune of those live (none pruned: always).
+        const std::uint64_t pruned_tris = tris_before - count_live_triangles(g);
+        const bool unproductive =
+            pruned_tris == 0 || static_cast<double>(pruned_tris) < min_prune * static_cast<double>(tris_before);
+        quiet = unproductive ? quiet + 1 : 0;
     }
     return Status{};
 }
@@ -370,184 +368,40 @@ std::vector<raster::Double3> to_double3(const Mesh& m) {
     return p;
 }
 
-Status check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active, const CullideOptions& o) {
+Result<ViewSize> check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                              const CullideOptions& o) {
     if (!(o.min_prune < 1.0))  // NaN too
         return Error{"min_prune must be below 1 (negative: the mode's default; got " + std::to_string(o.min_prune) +
                      ")"};
     if (o.object_stage != ObjectStage::Auto && o.object_stage != ObjectStage::On && o.object_stage != ObjectStage::Off)
         return Error{"object_stage is not Auto, On or Off"};
-    return detail::check_visibility_inputs(objects, active, o.resolution, o.subobject_triangles, o.max_rounds,
-                                           o.threads);
+    return detail::check_visibility_inputs(objects, active, o, o.mode);
 }
 
-// The triangles of the surviving sub-objects, paired across objects and tested exactly. As in the
-// ground truth (ground_truth.cpp): one task per pair of objects whose live boxes overlap, holding
-// only the live sub-objects whose boxes meet the intersection of the two, swept and pruned on the
-// axis where their centres spread most. A task sweeps sub-object boxes and then compares the
-// triangle boxes of each overlapping sub-object pair, unless its sub-object boxes are loose (the
-// consecutive triangles of a scrambled or thinned mesh lie far apart: their boxes' summed extent
-// along the axis is more than 4 times their triangles', so the sub-object sweep would meet more
-// overlaps than a sweep over the triangles, which has 4 times as many boxes); then it sweeps the
-// triangle boxes directly. On the thinned bunny-dragon the sub-object sweep met 1.4 million
-// sub-object pairs for 218 triangle pairs. Either way the triangle pairs tested are the same: the
-// live triangles of the two objects whose boxes overlap (two such boxes meet inside the common box).
+// The triangles of the surviving sub-objects, paired across objects and tested exactly: each live
+// sub-object is a candidate set of the exact stage (exact_stage.h).
 std::vector<TrianglePair> exact_stage(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
                                       const std::vector<ObjectGeometry>& g, int threads, CullideStats& st) {
-    struct Ref {  // a sub-object (tri = UINT32_MAX) or one of its triangles
-        std::uint32_t geom, item, tri;
-        const Aabb* box;
-    };
-    constexpr std::uint32_t kItem = 0xffffffffu;
-    std::vector<Aabb> live_box(g.size());
-    std::vector<char> has_live(g.size(), 0);
+    std::vector<detail::ExactObject> exact(g.size());
+    std::vector<detail::CandidateSet> sets;
     for (std::size_t i = 0; i < g.size(); ++i) {
+        const std::uint32_t object = active[g[i].active_index];
+        exact[i] = {&objects[object], object, Aabb{}, g[i].triangle_boxes, {}, {}};
         for (const Item& it : g[i].items) {
             if (!it.live) continue;
-            has_live[i] = 1;
-            live_box[i] = unite(live_box[i], it.box);
+            sets.push_back({static_cast<std::uint32_t>(i), it.first_index / 3, it.index_count / 3, it.box});
+            exact[i].box = unite(exact[i].box, it.box);
             st.candidate_triangles += it.index_count / 3;
         }
     }
-    struct Task {
-        std::vector<Ref> refs;  // sorted by (lo[axis], geom, item, tri): a unique key
-        int axis = 0;
-    };
-    std::vector<Task> tasks;
-    for (std::size_t i = 0; i < g.size(); ++i) {
-        if (!has_live[i]) continue;
-        for (std::size_t j = i + 1; j < g.size(); ++j) {
-            if (!has_live[j] || !overlaps(live_box[i], live_box[j])) continue;
-            Aabb common;
-            for (int k = 0; k < 3; ++k) {
-                common.lo[k] = std::max(live_box[i].lo[k], live_box[j].lo[k]);
-                common.hi[k] = std::min(live_box[i].hi[k], live_box[j].hi[k]);
-            }
-            Task task;
-            std::size_t from_i = 0;
-            for (const std::size_t o : {i, j}) {
-                for (std::size_t k = 0; k < g[o].items.size(); ++k) {
-                    const Item& it = g[o].items[k];
-                    if (it.live && overlaps(it.box, common))
-                        task.refs.push_back({static_cast<std::uint32_t>(o), static_cast<std::uint32_t>(k), kItem, &it.box});
-                }
-                if (o == i) from_i = task.refs.size();
-            }
-            if (from_i == 0 || from_i == task.refs.size()) continue;  // one side has nothing there
-            Aabb centres;
-            for (const Ref& r : task.refs) {
-                const double cx = 0.5 * r.box->lo.x + 0.5 * r.box->hi.x, cy = 0.5 * r.box->lo.y + 0.5 * r.box->hi.y,
-                             cz = 0.5 * r.box->lo.z + 0.5 * r.box->hi.z;
-                centres = unite(centres, Aabb{{cx, cy, cz}, {cx, cy, cz}});
-            }
-            for (int k = 1; k < 3; ++k)
-                if (centres.hi[k] - centres.lo[k] > centres.hi[task.axis] - centres.lo[task.axis]) task.axis = k;
-            const int axis = task.axis;
-            double item_extent = 0.0, tri_extent = 0.0;
-            for (const Ref& r : task.refs) {
-                item_extent += r.box->hi[axis] - r.box->lo[axis];
-                const Item& it = g[r.geom].items[r.item];
-                for (std::uint32_t t = it.first_index / 3; t < (it.first_index + it.index_count) / 3; ++t)
-                    tri_extent += g[r.geom].triangle_boxes[t].hi[axis] - g[r.geom].triangle_boxes[t].lo[axis];
-            }
-            if (item_extent > 4.0 * tri_extent) {  // loose sub-objects: sweep their triangles instead
-                std::vector<Ref> tris;
-                for (const Ref& r : task.refs) {
-                    const Item& it = g[r.geom].items[r.item];
-                    for (std::uint32_t t = it.first_index / 3; t < (it.first_index + it.index_count) / 3; ++t)
-                        if (overlaps(g[r.geom].triangle_boxes[t], common))
-                            tris.push_back({r.geom, r.item, t, &g[r.geom].triangle_boxes[t]});
-                }
-                task.refs = std::move(tris);
-            }
-            std::sort(task.refs.begin(), task.refs.end(), [axis](const Ref& a, const Ref& b) {
-                if (a.box->lo[axis] != b.box->lo[axis]) return a.box->lo[axis] < b.box->lo[axis];
-                if (a.geom != b.geom) return a.geom < b.geom;
-                if (a.item != b.item) return a.item < b.item;
-                return a.tri < b.tri;
-            });
-            tasks.push_back(std::move(task));
-        }
-    }
-    // Per task (tasks in a fixed order, each on one worker): its triangle pairs, lower geom first,
-    // in sweep order, each tested exactly.
-    struct TriPair {
-        std::uint32_t geom_a, item_a, tri_a, geom_b, item_b, tri_b;
-    };
-    std::vector<std::vector<TriPair>> task_pairs(tasks.size());
-    std::vector<std::vector<TrianglePair>> found(tasks.size());
-    detail::parallel_chunks(threads, tasks.size(), [&](std::size_t t) {
-        const std::vector<Ref>& refs = tasks[t].refs;
-        const int axis = tasks[t].axis;
-        auto& tp = task_pairs[t];
-        for (std::size_t a = 0; a < refs.size(); ++a) {
-            for (std::size_t b = a + 1; b < refs.size() && refs[b].box->lo[axis] <= refs[a].box->hi[axis]; ++b) {
-                if (refs[a].geom == refs[b].geom || !overlaps(*refs[a].box, *refs[b].box)) continue;
-                const Ref& ra = refs[a].geom < refs[b].geom ? refs[a] : refs[b];
-                const Ref& rb = refs[a].geom < refs[b].geom ? refs[b] : refs[a];
-                if (ra.tri != kItem) {
-                    tp.push_back({ra.geom, ra.item, ra.tri, rb.geom, rb.item, rb.tri});
-                    continue;
-                }
-                const Item& ia = g[ra.geom].items[ra.item];
-                const Item& ib = g[rb.geom].items[rb.item];
-                for (std::uint32_t ta = ia.first_index / 3; ta < (ia.first_index + ia.index_count) / 3; ++ta)
-                    for (std::uint32_t tb = ib.first_index / 3; tb < (ib.first_index + ib.index_count) / 3; ++tb)
-                        if (overlaps(g[ra.geom].triangle_boxes[ta], g[rb.geom].triangle_boxes[tb]))
-                            tp.push_back({ra.geom, ra.item, ta, rb.geom, rb.item, tb});
-            }
-        }
-        for (const TriPair& p : tp) {
-            const std::uint32_t oa = active[g[p.geom_a].active_index];
-            const std::uint32_t ob = active[g[p.geom_b].active_index];
-            const Mesh& ma = objects[oa];
-            const Mesh& mb = objects[ob];
-            const Tri& a = ma.triangles[p.tri_a];
-            const Tri& b = mb.triangles[p.tri_b];
-            if (tri_tri_intersect(ma.positions[a[0]], ma.positions[a[1]], ma.positions[a[2]], mb.positions[b[0]],
-                                  mb.positions[b[1]], mb.positions[b[2]]))
-                found[t].push_back({oa, p.tri_a, ob, p.tri_b});
-        }
-    });
-    std::vector<TrianglePair> pairs;
-    std::vector<std::array<std::uint32_t, 4>> keys;  // sub-object pairs holding some tested pair
-    for (std::size_t t = 0; t < tasks.size(); ++t) {
-        st.exact_tests += task_pairs[t].size();
-        for (const TriPair& p : task_pairs[t]) keys.push_back({p.geom_a, p.item_a, p.geom_b, p.item_b});
-        pairs.insert(pairs.end(), found[t].begin(), found[t].end());
-    }
-    std::sort(keys.begin(), keys.end());
-    st.subobject_pairs = static_cast<std::uint64_t>(std::unique(keys.begin(), keys.end()) - keys.begin());
-    std::sort(pairs.begin(), pairs.end());
-    return pairs;
+    detail::ExactStageResult r = detail::sweep_exact_stage(exact, sets, {false, true, threads});
+    st.exact_tests = r.stats.tests;
+    st.subobject_pairs = r.stats.set_pairs;
+    return std::move(r.pairs);
 }
 
-}  // namespace
-
-const char* to_string(CullStage s) {
-    switch (s) {
-        case CullStage::Boxes:
-            return "boxes";
-        case CullStage::Objects:
-            return "objects";
-        case CullStage::SubObjects:
-            return "subobjects";
-    }
-    return "?";
-}
-
-Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
-                                                const CullideOptions& options, QueryDevice& device,
-                                                CullideStats* stats) {
-    if (Status s = check_inputs(objects, active, options); !s) return s.error();
-    CullideStats st;
-    st.objects_in = active.size();
-    // Reused by every view of the frame and, per calling thread, by later frames: its buffers then
-    // stop growing after the first frame (no fresh pages to fault in per frame). It keeps no answer
-    // from one call to the next, so results cannot depend on what ran before.
-    thread_local raster::VisibilityPass fused;
-
-    // Stage 1: object boxes.
-    auto t0 = Clock::now();
+// Stage 1's geometry: each active object's box as one item of 12 triangles.
+std::vector<ObjectGeometry> box_geometry(std::span<const Mesh> objects, std::span<const std::uint32_t> active) {
     std::vector<ObjectGeometry> boxes(active.size());
     for (std::size_t k = 0; k < active.size(); ++k) {
         ObjectGeometry& og = boxes[k];
@@ -559,12 +413,12 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
         og.indices.assign(kBoxIndices.begin(), kBoxIndices.end());
         og.items.push_back({0, 36, b, true, {}});
     }
-    if (Status s = run_stage(boxes, CullStage::Boxes, options, device, st, fused); !s) return s.error();
-    st.pcs_boxes = count_live(boxes);
-    st.boxes_ms = ms_since(t0);
+    return boxes;
+}
 
-    // Stage 2: whole objects.
-    t0 = Clock::now();
+// Stage 2's geometry: the mesh of each object whose box survived, as one item.
+std::vector<ObjectGeometry> object_geometry(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                                            const std::vector<ObjectGeometry>& boxes) {
     std::vector<ObjectGeometry> whole;
     for (const ObjectGeometry& b : boxes) {
         if (!b.items[0].live) continue;
@@ -577,18 +431,15 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
         og.items.push_back({0, static_cast<std::uint32_t>(og.indices.size()), b.items[0].box, true, {}});
         whole.push_back(std::move(og));
     }
-    const bool object_stage = options.object_stage == ObjectStage::On ||
-                              (options.object_stage == ObjectStage::Auto && options.mode != VisibilityMode::ExactBounds);
-    if (object_stage)
-        if (Status s = run_stage(whole, CullStage::Objects, options, device, st, fused); !s) return s.error();
-    st.pcs_objects = count_live(whole);
-    st.objects_ms = ms_since(t0);
+    return whole;
+}
 
-    // Stage 3: sub-objects of consecutive triangles (neighbours in meshes stored strip- or
-    // patch-wise; see docs/cullide.md for what this choice costs on scrambled meshes).
-    t0 = Clock::now();
+// Stage 3's geometry: each surviving object split into sub-objects of `group` consecutive triangles
+// (neighbours in meshes stored strip- or patch-wise; see docs/cullide.md for what this choice costs
+// on scrambled meshes), with its triangles' boxes for the exact stage.
+std::vector<ObjectGeometry> subobject_geometry(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                                               std::vector<ObjectGeometry>&& whole, std::size_t group) {
     std::vector<ObjectGeometry> subs;
-    const auto group = static_cast<std::size_t>(options.subobject_triangles);
     for (ObjectGeometry& og : whole) {
         if (!og.items[0].live) continue;
         const Mesh& m = objects[active[og.active_index]];
@@ -602,14 +453,45 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
             og.items.push_back(
                 {static_cast<std::uint32_t>(first * 3), static_cast<std::uint32_t>((last - first) * 3), b, true, {}});
         }
-        st.subobjects += og.items.size();
         subs.push_back(std::move(og));
     }
-    if (Status s = run_stage(subs, CullStage::SubObjects, options, device, st, fused); !s) return s.error();
+    return subs;
+}
+
+}  // namespace
+
+Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                                                const CullideOptions& options, QueryDevice& device,
+                                                CullideStats* stats) {
+    Result<ViewSize> checked = check_inputs(objects, active, options);
+    if (!checked) return checked.error();
+    const ViewSize size = checked.value();
+    CullideStats st;
+    st.objects_in = active.size();
+
+    auto t0 = Clock::now();
+    std::vector<ObjectGeometry> boxes = box_geometry(objects, active);
+    if (Status s = run_stage(boxes, CullStage::Boxes, options, size, device, st); !s) return s.error();
+    st.pcs_boxes = count_live(boxes);
+    st.boxes_ms = ms_since(t0);
+
+    t0 = Clock::now();
+    std::vector<ObjectGeometry> whole = object_geometry(objects, active, boxes);
+    const bool object_stage = options.object_stage == ObjectStage::On ||
+                              (options.object_stage == ObjectStage::Auto && options.mode != VisibilityMode::ExactBounds);
+    if (object_stage)
+        if (Status s = run_stage(whole, CullStage::Objects, options, size, device, st); !s) return s.error();
+    st.pcs_objects = count_live(whole);
+    st.objects_ms = ms_since(t0);
+
+    t0 = Clock::now();
+    std::vector<ObjectGeometry> subs =
+        subobject_geometry(objects, active, std::move(whole), static_cast<std::size_t>(options.subobject_triangles));
+    for (const ObjectGeometry& og : subs) st.subobjects += og.items.size();
+    if (Status s = run_stage(subs, CullStage::SubObjects, options, size, device, st); !s) return s.error();
     st.pcs_subobjects = count_live(subs);
     st.subobjects_ms = ms_since(t0);
 
-    // Stage 4: exact.
     t0 = Clock::now();
     std::vector<TrianglePair> pairs = exact_stage(objects, active, subs, options.threads, st);
     st.exact_ms = ms_since(t0);
@@ -621,18 +503,16 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
 
 namespace cullide::detail {
 
-Status check_visibility_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active, int resolution,
-                               int subobject_triangles, int max_rounds, int threads) {
-    if (resolution < 1 || resolution > raster::kMaxTargetSize)
-        return Error{"resolution must be in 1.." + std::to_string(raster::kMaxTargetSize) + " (got " +
-                     std::to_string(resolution) + ")"};
-    if (subobject_triangles < 1)
-        return Error{"sub-object size must be >= 1 triangle (got " + std::to_string(subobject_triangles) + ")"};
-    if (max_rounds < 1 || max_rounds > kMaxRounds)
-        return Error{"max_rounds must be in 1.." + std::to_string(kMaxRounds) + " (got " + std::to_string(max_rounds) +
-                     ")"};
-    if (threads < 0) return Error{"threads must be >= 0 (got " + std::to_string(threads) + ")"};
-    if (Status s = validate_scene(objects); !s) return s;
+Result<ViewSize> check_visibility_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                                         const VisibilityOptions& o, VisibilityMode mode) {
+    Result<ViewSize> size = view_size(o.resolution, mode);
+    if (!size) return size.error();
+    if (o.subobject_triangles < 1)
+        return Error{"sub-object size must be >= 1 triangle (got " + std::to_string(o.subobject_triangles) + ")"};
+    if (o.max_rounds < 1 || o.max_rounds > kMaxRounds)
+        return Error{"max_rounds must be in 1.." + std::to_string(kMaxRounds) + " (got " + std::to_string(o.max_rounds) + ")"};
+    if (o.threads < 0) return Error{"threads must be >= 0 (got " + std::to_string(o.threads) + ")"};
+    if (Status s = validate_scene(objects); !s) return s.error();
     if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
     for (std::size_t k = 0; k < active.size(); ++k) {
         if (active[k] >= objects.size())
@@ -655,7 +535,7 @@ Status check_visibility_inputs(std::span<const Mesh> objects, std::span<const st
             }
         }
     }
-    return Status{};
+    return size;
 }
 
 }  // namespace cullide::detail

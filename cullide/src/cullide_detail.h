@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <span>
 
-#include "cullide/cullide.h"
+#include "cullide/visibility.h"
 #include "cullide/mesh.h"
 #include "cullide/result.h"
 #include "raster/transform.h"
@@ -17,14 +17,16 @@ namespace cullide::detail {
 // clip coordinates are rounded to float.
 void widen(double& lo, double& hi);
 // The orthographic view along `axis` fitted to `bounds` (widened as above), with `extra_depth` more
-// world units before and after along the axis; resolution and depth format from `o`.
-[[nodiscard]] Result<raster::OrthoView> make_view(int axis, const Aabb& bounds, double extra_depth,
-                                                  const CullideOptions& o);
+// world units before and after along the axis, of `size` pixels and `format`.
+[[nodiscard]] Result<raster::OrthoView> make_view(int axis, const Aabb& bounds, double extra_depth, ViewSize size,
+                                                  raster::DepthFormat format);
 
 // The checks every visibility method makes before drawing anything: option ranges, a valid scene,
 // `active` strictly increasing and in range, and every active object's coordinates inside the
-// exact range (with the ground truth's message, so all methods refuse alike).
-[[nodiscard]] Status check_visibility_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
-                                             int resolution, int subobject_triangles, int max_rounds, int threads);
+// exact range (with the ground truth's message, so all methods refuse alike). Returns the views'
+// size: the one place a method's resolution is checked and its default applied.
+[[nodiscard]] Result<ViewSize> check_visibility_inputs(std::span<const Mesh> objects,
+                                                       std::span<const std::uint32_t> active,
+                                                       const VisibilityOptions& o, VisibilityMode mode);
 
 }  // namespace cullide::detail

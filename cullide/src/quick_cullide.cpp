@@ -6,8 +6,8 @@
 #include <chrono>
 #include <string>
 
-#include "cullide/tri_tri.h"
 #include "cullide_detail.h"
+#include "exact_stage.h"
 #include "parallel.h"
 #include "raster/command_batch.h"
 #include "raster/depth_target.h"
@@ -54,11 +54,11 @@ struct Item {
     std::uint32_t query = 0;
 };
 
-Status check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active, const QuickOptions& o) {
+Result<ViewSize> check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                              const QuickOptions& o) {
     if (o.mode == VisibilityMode::Offset)
         return Error{"Quick-CULLIDE runs in GL-exact or exact-bounds mode, not with offset solids"};
-    return detail::check_visibility_inputs(objects, active, o.resolution, o.subobject_triangles, o.max_rounds,
-                                           o.threads);
+    return detail::check_visibility_inputs(objects, active, o, o.mode);
 }
 
 std::uint64_t count_live(const std::vector<Item>& items) {
@@ -80,9 +80,9 @@ std::uint64_t record_draw(raster::CommandBatch& batch, const Geom& g, const Item
     return it.count;
 }
 
-Status run_device(QueryDevice& device, const raster::CommandBatch& batch, const QuickOptions& o,
+Status run_device(QueryDevice& device, const raster::CommandBatch& batch, ViewSize size, raster::DepthFormat format,
                   raster::QueryResults& out) {
-    if (Status s = device.clear(o.resolution, o.resolution, o.depth_format); !s) return s;
+    if (Status s = device.clear(size.width(), size.height(), format); !s) return s;
     Result<raster::QueryResults> r = device.execute(batch);
     if (!r) return r.error();
     if (r.value().size() != batch.query_kinds().size())
@@ -92,17 +92,71 @@ Status run_device(QueryDevice& device, const raster::CommandBatch& batch, const 
     return Status{};
 }
 
+// This view's clip coordinates of every geometry with a live item.
+Status transform_geoms(std::vector<Geom>& geoms, const std::vector<char>& geom_live, const raster::OrthoView& view,
+                       VisibilityMode mode) {
+    for (std::size_t gi = 0; gi < geoms.size(); ++gi) {
+        if (!geom_live[gi]) continue;
+        Geom& g = geoms[gi];
+        raster::Result<std::vector<raster::Double4>> c = raster::ortho_view_to_clip(view, g.positions);
+        if (!c) return Error{"view transform: " + c.error().message};
+        if (mode == VisibilityMode::ExactBounds) {
+            g.clip_d = std::move(c).value();
+            continue;
+        }
+        g.clip.resize(c.value().size());
+        for (std::size_t i = 0; i < g.clip.size(); ++i) {
+            const raster::Double4& d = c.value()[i];
+            g.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), static_cast<float>(d.z), 1.0f};
+        }
+    }
+    return Status{};
+}
+
+// One pass of a view: forward (pass 1) queries items that are not FFV and draws those that are not
+// SFV, item j right after the query of item near_hi[j]; backward (pass 2) the mirror image, with
+// near_lo. Both are non-decreasing in j, so one cursor schedules every deferred draw. Items whose
+// query passes no sample gain the pass's tag; returns how many did.
+Result<std::uint64_t> run_pass(const std::vector<Geom>& geoms, std::vector<Item>& items, bool forward,
+                               const QuickOptions& o, ViewSize size, QueryDevice& device, ViewStats& vs) {
+    const std::uint8_t proven = forward ? kFFV : kSFV;  // what this pass proves
+    const std::uint8_t other = forward ? kSFV : kFFV;   // items with this tag are not drawn
+    const std::size_t n = items.size();
+    raster::CommandBatch batch(size.width(), size.height());
+    std::size_t cursor = 0;  // draws scheduled so far, counted from the pass's start
+    for (std::size_t step = 0; step < n; ++step) {
+        const std::size_t k = forward ? step : n - 1 - step;
+        Item& it = items[k];
+        if (!(it.tag & proven)) {
+            it.query = batch.begin_query(raster::QueryKind::AnySamplesPassed);
+            vs.triangles_rasterized += record_draw(batch, geoms[it.geom], it, o.mode, true);
+            batch.end_query();
+            ++vs.queries;
+        }
+        if (step + 1 == n) break;  // nothing is queried after the last item
+        for (; cursor < n; ++cursor) {
+            const Item& d = items[forward ? cursor : n - 1 - cursor];
+            if (forward ? d.near_hi > k : d.near_lo < k) break;
+            if (!(d.tag & other)) vs.triangles_rasterized += record_draw(batch, geoms[d.geom], d, o.mode, false);
+        }
+    }
+    raster::QueryResults res;
+    if (Status s = run_device(device, batch, size, o.depth_format, res); !s) return s.error();
+    std::uint64_t changed = 0;
+    for (Item& it : items) {
+        if (!(it.tag & proven) && res[it.query] == 0) {
+            it.tag |= proven;
+            ++changed;
+        }
+    }
+    return changed;
+}
+
 // Views until three views in a row are quiet (gain at most 1/64 of the live items' count in tags)
 // or 3 * max_rounds ran.
-// Pass 1 draws item j right after the query of item near_hi[j] (pass 2: near_lo[j]); both are
-// non-decreasing in j, so one cursor per pass schedules every deferred draw.
 Status run_stage(std::vector<Geom>& geoms, std::vector<Item>& items, CullStage stage, const QuickOptions& o,
-                 QueryDevice& device, QuickStats& st) {
+                 ViewSize size, QueryDevice& device, QuickStats& st) {
     if (o.skip_visibility) return Status{};
-    CullideOptions co;
-    co.resolution = o.resolution;
-    co.depth_format = o.depth_format;
-    const std::size_t n = items.size();
     int quiet = 0;
     int first_axis = -1;  // the thinnest axis of the stage's first live bounds (see below)
     for (int view = 0; view < 3 * o.max_rounds && quiet < 3; ++view) {
@@ -124,79 +178,18 @@ Status run_stage(std::vector<Geom>& geoms, std::vector<Item>& items, CullStage s
                 if (bounds.hi[k] - bounds.lo[k] < bounds.hi[first_axis] - bounds.lo[first_axis]) first_axis = k;
         }
         const int axis = (first_axis + view) % 3;
-        Result<raster::OrthoView> v = detail::make_view(axis, bounds, 0.0, co);
+        Result<raster::OrthoView> v = detail::make_view(axis, bounds, 0.0, size, o.depth_format);
         if (!v) return v.error();
-        for (std::size_t gi = 0; gi < geoms.size(); ++gi) {
-            if (!geom_live[gi]) continue;
-            Geom& g = geoms[gi];
-            raster::Result<std::vector<raster::Double4>> c = raster::ortho_view_to_clip(v.value(), g.positions);
-            if (!c) return Error{"view transform: " + c.error().message};
-            if (o.mode == VisibilityMode::ExactBounds) {
-                g.clip_d = std::move(c).value();
-            } else {
-                g.clip.resize(c.value().size());
-                for (std::size_t i = 0; i < g.clip.size(); ++i) {
-                    const raster::Double4& d = c.value()[i];
-                    g.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), static_cast<float>(d.z), 1.0f};
-                }
-            }
-        }
+        if (Status s = transform_geoms(geoms, geom_live, v.value(), o.mode); !s) return s;
         ViewStats vs;
         vs.stage = stage;
         vs.axis = axis;
         vs.items_before = live;
         std::uint64_t changed = 0;  // tags gained in this view
-        raster::QueryResults res;
-        // Pass 1, forward.
-        {
-            raster::CommandBatch batch(o.resolution, o.resolution);
-            std::size_t r = 0;
-            for (std::size_t k = 0; k < n; ++k) {
-                Item& it = items[k];
-                if (!(it.tag & kFFV)) {
-                    it.query = batch.begin_query(raster::QueryKind::AnySamplesPassed);
-                    vs.triangles_rasterized += record_draw(batch, geoms[it.geom], it, o.mode, true);
-                    batch.end_query();
-                    ++vs.queries;
-                }
-                if (k + 1 == n) break;  // nothing is queried after the last item
-                for (; r < n && items[r].near_hi <= k; ++r)
-                    if (!(items[r].tag & kSFV))
-                        vs.triangles_rasterized += record_draw(batch, geoms[items[r].geom], items[r], o.mode, false);
-            }
-            if (Status s = run_device(device, batch, o, res); !s) return s;
-            for (Item& it : items) {
-                if (!(it.tag & kFFV) && res[it.query] == 0) {
-                    it.tag |= kFFV;
-                    ++changed;
-                }
-            }
-        }
-        // Pass 2, backward.
-        {
-            raster::CommandBatch batch(o.resolution, o.resolution);
-            std::size_t r = n;  // items [r, n) are scheduled
-            for (std::size_t k = n; k-- > 0;) {
-                Item& it = items[k];
-                if (!(it.tag & kSFV)) {
-                    it.query = batch.begin_query(raster::QueryKind::AnySamplesPassed);
-                    vs.triangles_rasterized += record_draw(batch, geoms[it.geom], it, o.mode, true);
-                    batch.end_query();
-                    ++vs.queries;
-                }
-                if (k == 0) break;
-                for (; r > 0 && items[r - 1].near_lo >= k; --r)
-                    if (!(items[r - 1].tag & kFFV))
-                        vs.triangles_rasterized +=
-                            record_draw(batch, geoms[items[r - 1].geom], items[r - 1], o.mode, false);
-            }
-            if (Status s = run_device(device, batch, o, res); !s) return s;
-            for (Item& it : items) {
-                if (!(it.tag & kSFV) && res[it.query] == 0) {
-                    it.tag |= kSFV;
-                    ++changed;
-                }
-            }
+        for (const bool forward : {true, false}) {
+            Result<std::uint64_t> gained = run_pass(geoms, items, forward, o, size, device, vs);
+            if (!gained) return gained.error();
+            changed += gained.value();
         }
         vs.items_after = count_live(items);
         st.queries += vs.queries;
@@ -331,43 +324,17 @@ void set_object_near(std::vector<Item>& items) {
 
 bool near(const Item& a, std::size_t b) { return b >= a.near_lo && b <= a.near_hi; }
 
-bool share_vertex(const Geom& g, const Mesh& m, std::uint32_t ta, std::uint32_t tb) {
-    for (std::uint32_t va : m.triangles[ta])
-        for (std::uint32_t vb : m.triangles[tb])
-            if (g.weld[va] == g.weld[vb]) return true;
-    return false;
-}
-
 using ItemPair = std::pair<std::uint32_t, std::uint32_t>;
 
-// Item pairs (a < b) whose boxes overlap, by sweep and prune on the axis of greatest extent; BFV
-// items only when `with_bfv`. Sorted.
-std::vector<ItemPair> box_pairs(const std::vector<Item>& items, bool with_bfv) {
-    std::vector<std::uint32_t> refs;
-    Aabb all;
+// Item pairs (a < b) whose boxes overlap, by sweep and prune (exact_stage.h); BFV items only when
+// `with_bfv`. Sorted.
+std::vector<ItemPair> box_pairs(const std::vector<Item>& items, bool with_bfv, int threads) {
+    std::vector<detail::SweepRef> refs;
     for (std::size_t i = 0; i < items.size(); ++i) {
         if (items[i].tag == kBFV && !with_bfv) continue;
-        refs.push_back(static_cast<std::uint32_t>(i));
-        all = detail::unite(all, items[i].box);
+        refs.push_back({items[i].box, items[i].geom, static_cast<std::uint32_t>(i), detail::kWholeSet});
     }
-    std::vector<ItemPair> out;
-    if (refs.empty()) return out;
-    int axis = 0;
-    for (int k = 1; k < 3; ++k)
-        if (all.hi[k] - all.lo[k] > all.hi[axis] - all.lo[axis]) axis = k;
-    std::sort(refs.begin(), refs.end(), [&](std::uint32_t x, std::uint32_t y) {
-        if (items[x].box.lo[axis] != items[y].box.lo[axis]) return items[x].box.lo[axis] < items[y].box.lo[axis];
-        return x < y;
-    });
-    for (std::size_t i = 0; i < refs.size(); ++i) {
-        const Item& ri = items[refs[i]];
-        for (std::size_t j = i + 1; j < refs.size() && items[refs[j]].box.lo[axis] <= ri.box.hi[axis]; ++j) {
-            if (!overlaps(ri.box, items[refs[j]].box)) continue;
-            out.emplace_back(std::min(refs[i], refs[j]), std::max(refs[i], refs[j]));
-        }
-    }
-    std::sort(out.begin(), out.end());
-    return out;
+    return detail::overlapping_sets(std::move(refs), threads);
 }
 
 // Self-collision box classification (ours, before the visibility passes): an item whose box meets
@@ -387,10 +354,7 @@ void box_tags(std::vector<Item>& items, const std::vector<ItemPair>& overlapping
 std::vector<TrianglePair> exact_stage(std::span<const Mesh> objects, const std::vector<Geom>& geoms,
                                       const std::vector<Item>& items, const std::vector<ItemPair>& overlapping,
                                       const QuickOptions& o, QuickStats& st) {
-    struct Pair {
-        std::uint32_t a, b;
-        bool near;
-    };
+    using Pair = detail::CandidatePair;
     std::vector<Pair> pairs;
     if (o.self)
         for (std::size_t i = 0; i < items.size(); ++i)
@@ -413,55 +377,133 @@ std::vector<TrianglePair> exact_stage(std::span<const Mesh> objects, const std::
         }
     }
 
-    constexpr std::size_t kChunk = 64;  // item pairs per task: fixed, so the output is thread-independent
-    const std::size_t chunks = (pairs.size() + kChunk - 1) / kChunk;
-    struct ChunkOut {
-        std::vector<TrianglePair> found;
-        std::uint64_t tests = 0, near_tests = 0, adjacent = 0;
-    };
-    std::vector<ChunkOut> out(chunks);
-    detail::parallel_chunks(o.threads, chunks, [&](std::size_t c) {
-        ChunkOut& co = out[c];
-        const std::size_t end = std::min(pairs.size(), (c + 1) * kChunk);
-        for (std::size_t p = c * kChunk; p < end; ++p) {
-            const Item& ia = items[pairs[p].a];
-            const Item& ib = items[pairs[p].b];
-            const Geom& ga = geoms[ia.geom];
-            const Geom& gb = geoms[ib.geom];
-            const Mesh& ma = objects[ga.object];
-            const Mesh& mb = objects[gb.object];
-            const bool same = ia.geom == ib.geom;
-            for (std::uint32_t pa = ia.first; pa < ia.first + ia.count; ++pa) {
-                const std::uint32_t first_b = pairs[p].a == pairs[p].b ? pa + 1 : ib.first;
-                for (std::uint32_t pb = first_b; pb < ib.first + ib.count; ++pb) {
-                    if (!overlaps(ga.tri_box[pa], gb.tri_box[pb])) continue;
-                    std::uint32_t ta = ga.order[pa], tb = gb.order[pb];
-                    if (same && share_vertex(ga, ma, ta, tb)) {
-                        ++co.adjacent;
-                        continue;
-                    }
-                    ++co.tests;
-                    co.near_tests += pairs[p].near ? 1 : 0;
-                    const Tri& a = ma.triangles[ta];
-                    const Tri& b = mb.triangles[tb];
-                    if (tri_tri_intersect(ma.positions[a[0]], ma.positions[a[1]], ma.positions[a[2]], mb.positions[b[0]],
-                                          mb.positions[b[1]], mb.positions[b[2]])) {
-                        if (same && tb < ta) std::swap(ta, tb);
-                        co.found.push_back({ga.object, ta, gb.object, tb});
-                    }
-                }
-            }
-        }
-    });
-    std::vector<TrianglePair> result;
-    for (const ChunkOut& co : out) {
-        st.exact_tests += co.tests;
-        st.near_exact_tests += co.near_tests;
-        st.adjacent_skipped += co.adjacent;
-        result.insert(result.end(), co.found.begin(), co.found.end());
+    std::vector<detail::ExactObject> exact(geoms.size());
+    for (std::size_t g = 0; g < geoms.size(); ++g)
+        exact[g] = {&objects[geoms[g].object], geoms[g].object, Aabb{}, geoms[g].tri_box, geoms[g].order, geoms[g].weld};
+    std::vector<detail::CandidateSet> sets(items.size());
+    for (std::size_t i = 0; i < items.size(); ++i) sets[i] = {items[i].geom, items[i].first, items[i].count, items[i].box};
+    detail::ExactStageResult r = detail::listed_exact_stage(exact, sets, pairs, o.threads);
+    st.exact_tests = r.stats.tests;
+    st.near_exact_tests = r.stats.near_tests;
+    st.adjacent_skipped = r.stats.adjacent_skipped;
+    return std::move(r.pairs);
+}
+
+// Self-collision off: object boxes -> objects -> sub-objects -> single triangles, tags inherited
+// from stage to stage. Leaves the last stage's geometry and items in `geoms` and `items`.
+Status separate_stages(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                       const QuickOptions& options, ViewSize size, QueryDevice& device, std::vector<Geom>& geoms,
+                       std::vector<Item>& items, QuickStats& st) {
+    const auto group = static_cast<std::size_t>(options.subobject_triangles);
+    // Stage 1: object boxes.
+    auto t0 = Clock::now();
+    std::vector<Geom> boxes(active.size());
+    std::vector<Item> box_items(active.size());
+    for (std::size_t k = 0; k < active.size(); ++k) {
+        const Aabb b = mesh_bounds(objects[active[k]]);
+        Geom& g = boxes[k];
+        g.object = active[k];
+        g.positions.resize(8);
+        for (std::size_t c = 0; c < 8; ++c)
+            g.positions[c] = {(c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z};
+        g.indices.assign(kBoxIndices.begin(), kBoxIndices.end());
+        box_items[k].geom = static_cast<std::uint32_t>(k);
+        box_items[k].first = 0;
+        box_items[k].count = 12;
+        box_items[k].box = b;
     }
-    std::sort(result.begin(), result.end());
-    return result;
+    set_object_near(box_items);
+    if (Status s = run_stage(boxes, box_items, CullStage::Boxes, options, size, device, st); !s) return s;
+    st.pcs_boxes = count_live(box_items);
+    st.boxes_ms = ms_since(t0);
+
+    // Stage 2: whole objects (the live boxes' objects, tags inherited).
+    t0 = Clock::now();
+    for (const Item& b : box_items) {
+        if (b.tag == kBFV) continue;
+        const std::uint32_t object = boxes[b.geom].object;
+        const Mesh& m = objects[object];
+        std::vector<std::uint32_t> order(m.triangles.size());
+        for (std::size_t t = 0; t < order.size(); ++t) order[t] = static_cast<std::uint32_t>(t);
+        Item it;
+        it.geom = static_cast<std::uint32_t>(geoms.size());
+        it.first = 0;
+        it.count = static_cast<std::uint32_t>(order.size());
+        it.box = b.box;
+        it.tag = b.tag;
+        geoms.push_back(make_mesh_geom(m, object, std::move(order)));
+        items.push_back(it);
+    }
+    set_object_near(items);
+    if (Status s = run_stage(geoms, items, CullStage::Objects, options, size, device, st); !s) return s;
+    st.pcs_objects = count_live(items);
+    st.objects_ms = ms_since(t0);
+
+    // Stage 3: sub-objects; stage 4: single triangles (when sub-objects hold more than one).
+    t0 = Clock::now();
+    items = split_items(geoms, items, group);
+    set_object_near(items);
+    st.subobjects = items.size();
+    if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, size, device, st); !s) return s;
+    st.pcs_subobjects = count_live(items);
+    if (group > 1) {
+        items = split_items(geoms, items, 1);
+        set_object_near(items);
+        st.triangles_in = items.size();
+        if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, size, device, st); !s) return s;
+        st.pcs_triangles = count_live(items);
+    }
+    st.subobjects_ms = ms_since(t0);
+    return Status{};
+}
+
+// Self-collision on: one stage over every object's sub-objects, each object's triangles in a
+// bandwidth-reducing order, near = within the object's window. Leaves the geometry, the items and
+// their overlapping box pairs (BFV items included: their near pairs stay open).
+Status self_stage(std::span<const Mesh> objects, std::span<const std::uint32_t> active, const QuickOptions& options,
+                  ViewSize size, QueryDevice& device, std::vector<Geom>& geoms, std::vector<Item>& items,
+                  std::vector<ItemPair>& overlapping, QuickStats& st) {
+    const auto group = static_cast<std::size_t>(options.subobject_triangles);
+    auto t0 = Clock::now();
+    for (std::uint32_t object : active) {
+        const Mesh& m = objects[object];
+        std::vector<std::uint32_t> weld = weld_vertices(m);
+        const VertexTriangles vt = vertex_triangles(m, weld);
+        std::vector<std::uint32_t> input(m.triangles.size());
+        for (std::size_t t = 0; t < input.size(); ++t) input[t] = static_cast<std::uint32_t>(t);
+        std::vector<std::uint32_t> last;
+        (void)bfs_order(m, weld, vt, {}, &last);
+        std::vector<std::uint32_t> bfs = bfs_order(m, weld, vt, last, nullptr);
+        const std::uint32_t w_in = window_of(input, group, vt);
+        const std::uint32_t w_bfs = window_of(bfs, group, vt);
+        const std::uint32_t w = std::min(w_in, w_bfs);
+        st.window_max = std::max<std::uint64_t>(st.window_max, w);
+        const auto gi = static_cast<std::uint32_t>(geoms.size());
+        geoms.push_back(make_mesh_geom(m, object, w_bfs < w_in ? std::move(bfs) : std::move(input)));
+        geoms.back().weld = std::move(weld);
+        Item whole;
+        whole.geom = gi;
+        whole.count = static_cast<std::uint32_t>(m.triangles.size());
+        const std::size_t s = items.size();
+        std::vector<Item> parts = split_items(geoms, std::vector<Item>{whole}, group);
+        const std::size_t e = s + parts.size();
+        for (std::size_t k = 0; k < parts.size(); ++k) {
+            const std::size_t pos = s + k;
+            parts[k].near_lo = static_cast<std::uint32_t>(pos >= s + w ? pos - w : s);
+            parts[k].near_hi = static_cast<std::uint32_t>(std::min<std::size_t>(e - 1, pos + w));
+            items.push_back(parts[k]);
+        }
+    }
+    st.subobjects = items.size();
+    // Box pairs once (they include BFV items: their near pairs stay open); the box tags leave
+    // to the passes only the items with a far overlapping box.
+    overlapping = box_pairs(items, true, options.threads);
+    if (!options.skip_visibility) box_tags(items, overlapping);
+    st.pcs_boxes = count_live(items);
+    if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, size, device, st); !s) return s;
+    st.pcs_subobjects = count_live(items);
+    st.subobjects_ms = ms_since(t0);
+    return Status{};
 }
 
 }  // namespace
@@ -470,120 +512,22 @@ Result<std::vector<TrianglePair>> quick_cullide_pairs(std::span<const Mesh> obje
                                                       std::span<const std::uint32_t> active,
                                                       const QuickOptions& options, QueryDevice& device,
                                                       QuickStats* stats) {
-    if (Status s = check_inputs(objects, active, options); !s) return s.error();
+    Result<ViewSize> checked = check_inputs(objects, active, options);
+    if (!checked) return checked.error();
+    const ViewSize size = checked.value();
     QuickStats st;
     st.objects_in = active.size();
-    const auto group = static_cast<std::size_t>(options.subobject_triangles);
     std::vector<Geom> geoms;
     std::vector<Item> items;
     std::vector<ItemPair> overlapping;
 
-    if (!options.self) {
-        // Stage 1: object boxes.
-        auto t0 = Clock::now();
-        std::vector<Geom> boxes(active.size());
-        std::vector<Item> box_items(active.size());
-        for (std::size_t k = 0; k < active.size(); ++k) {
-            const Aabb b = mesh_bounds(objects[active[k]]);
-            Geom& g = boxes[k];
-            g.object = active[k];
-            g.positions.resize(8);
-            for (std::size_t c = 0; c < 8; ++c)
-                g.positions[c] = {(c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z};
-            g.indices.assign(kBoxIndices.begin(), kBoxIndices.end());
-            box_items[k].geom = static_cast<std::uint32_t>(k);
-            box_items[k].first = 0;
-            box_items[k].count = 12;
-            box_items[k].box = b;
-        }
-        set_object_near(box_items);
-        if (Status s = run_stage(boxes, box_items, CullStage::Boxes, options, device, st); !s) return s.error();
-        st.pcs_boxes = count_live(box_items);
-        st.boxes_ms = ms_since(t0);
-
-        // Stage 2: whole objects (the live boxes' objects, tags inherited).
-        t0 = Clock::now();
-        for (const Item& b : box_items) {
-            if (b.tag == kBFV) continue;
-            const std::uint32_t object = boxes[b.geom].object;
-            const Mesh& m = objects[object];
-            std::vector<std::uint32_t> order(m.triangles.size());
-            for (std::size_t t = 0; t < order.size(); ++t) order[t] = static_cast<std::uint32_t>(t);
-            Item it;
-            it.geom = static_cast<std::uint32_t>(geoms.size());
-            it.first = 0;
-            it.count = static_cast<std::uint32_t>(order.size());
-            it.box = b.box;
-            it.tag = b.tag;
-            geoms.push_back(make_mesh_geom(m, object, std::move(order)));
-            items.push_back(it);
-        }
-        set_object_near(items);
-        if (Status s = run_stage(geoms, items, CullStage::Objects, options, device, st); !s) return s.error();
-        st.pcs_objects = count_live(items);
-        st.objects_ms = ms_since(t0);
-
-        // Stage 3: sub-objects; stage 4: single triangles (when sub-objects hold more than one).
-        t0 = Clock::now();
-        items = split_items(geoms, items, group);
-        set_object_near(items);
-        st.subobjects = items.size();
-        if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, device, st); !s) return s.error();
-        st.pcs_subobjects = count_live(items);
-        if (group > 1) {
-            items = split_items(geoms, items, 1);
-            set_object_near(items);
-            st.triangles_in = items.size();
-            if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, device, st); !s) return s.error();
-            st.pcs_triangles = count_live(items);
-        }
-        st.subobjects_ms = ms_since(t0);
-    } else {
-        // Self-collision: one stage over every object's sub-objects, each object's triangles in a
-        // bandwidth-reducing order, near = within the object's window.
-        auto t0 = Clock::now();
-        for (std::uint32_t object : active) {
-            const Mesh& m = objects[object];
-            std::vector<std::uint32_t> weld = weld_vertices(m);
-            const VertexTriangles vt = vertex_triangles(m, weld);
-            std::vector<std::uint32_t> input(m.triangles.size());
-            for (std::size_t t = 0; t < input.size(); ++t) input[t] = static_cast<std::uint32_t>(t);
-            std::vector<std::uint32_t> last;
-            (void)bfs_order(m, weld, vt, {}, &last);
-            std::vector<std::uint32_t> bfs = bfs_order(m, weld, vt, last, nullptr);
-            const std::uint32_t w_in = window_of(input, group, vt);
-            const std::uint32_t w_bfs = window_of(bfs, group, vt);
-            const std::uint32_t w = std::min(w_in, w_bfs);
-            st.window_max = std::max<std::uint64_t>(st.window_max, w);
-            const auto gi = static_cast<std::uint32_t>(geoms.size());
-            geoms.push_back(make_mesh_geom(m, object, w_bfs < w_in ? std::move(bfs) : std::move(input)));
-            geoms.back().weld = std::move(weld);
-            Item whole;
-            whole.geom = gi;
-            whole.count = static_cast<std::uint32_t>(m.triangles.size());
-            const std::size_t s = items.size();
-            std::vector<Item> parts = split_items(geoms, std::vector<Item>{whole}, group);
-            const std::size_t e = s + parts.size();
-            for (std::size_t k = 0; k < parts.size(); ++k) {
-                const std::size_t pos = s + k;
-                parts[k].near_lo = static_cast<std::uint32_t>(pos >= s + w ? pos - w : s);
-                parts[k].near_hi = static_cast<std::uint32_t>(std::min<std::size_t>(e - 1, pos + w));
-                items.push_back(parts[k]);
-            }
-        }
-        st.subobjects = items.size();
-        // Box pairs once (they include BFV items: their near pairs stay open); the box tags leave
-        // to the passes only the items with a far overlapping box.
-        overlapping = box_pairs(items, true);
-        if (!options.skip_visibility) box_tags(items, overlapping);
-        st.pcs_boxes = count_live(items);
-        if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, device, st); !s) return s.error();
-        st.pcs_subobjects = count_live(items);
-        st.subobjects_ms = ms_since(t0);
-    }
+    const Status ran = options.self
+                           ? self_stage(objects, active, options, size, device, geoms, items, overlapping, st)
+                           : separate_stages(objects, active, options, size, device, geoms, items, st);
+    if (!ran) return ran.error();
 
     auto t0 = Clock::now();
-    if (!options.self) overlapping = box_pairs(items, false);
+    if (!options.self) overlapping = box_pairs(items, false, options.threads);
     std::vector<TrianglePair> pairs = exact_stage(objects, geoms, items, overlapping, options, st);
     st.exact_ms = ms_since(t0);
     if (stats != nullptr) *stats = std::move(st);

@@ -19,7 +19,10 @@
 //  4. exact: per pair of objects whose live boxes overlap, the live sub-objects meeting the two
 //     boxes' intersection swept and pruned on their boxes (or on their triangles' boxes when the
 //     sub-object boxes are loose), then the triangle pairs whose boxes overlap, then the exact test
-//     of tri_tri.h.
+//     of tri_tri.h: the exact stage every method shares (the ground truth included), with the live
+//     sub-objects as its candidate sets.
+// Views run on a QueryDevice (query_device.h): GLExact and Offset record each pass as a command
+// batch; ExactBounds hands both passes of a view to QueryDevice::visibility_pass at once.
 // Pass k of a view: clear depth; for each live object in order (pass 1) or reverse order (pass 2):
 // query its live items (GEQUAL, depth mask off, one any-samples query each), then write them
 // (LEQUAL, mask on). An item whose queries pass no sample in both passes is fully visible with
@@ -45,27 +48,9 @@
 #include "cullide/mesh.h"
 #include "cullide/query_device.h"
 #include "cullide/result.h"
-#include "raster/types.h"
+#include "cullide/visibility.h"
 
 namespace cullide {
-
-enum class VisibilityMode : std::uint8_t {
-    // The original: pixel-centre sampling, depth at the pixel centre (raster GL-exact mode). Can
-    // miss collisions (sampling and depth-precision errors, algorithms.md section 4).
-    GLExact,
-    // R-CULLIDE, exact bounds (ours): the triangles themselves in the emulator's conservative
-    // raster mode (RasterMode::ExactBounds: every pixel a triangle touches, writes at the zmin and
-    // queries at the zmax of the triangle over the pixel, rounded outward). Never misses. Runs only
-    // on a device that implements that mode (the emulator).
-    ExactBounds,
-    // R-CULLIDE as the paper builds it: offset solids (raster/offset_geometry.h) drawn with
-    // pixel-centre GL rules, so any GL runs it: object boxes and per-triangle boxes grown by
-    // r = sqrt(3) p / 2, objects as unions of oriented boxes; queries draw the far faces
-    // (CullFace::Front), writes the near ones (CullFace::Back). Never misses.
-    Offset,
-};
-
-enum class CullStage : std::uint8_t { Boxes, Objects, SubObjects };
 
 // Stage 2 (whole objects). A sub-object view prunes every object that an object view of the same
 // PCS would prune (an object's fragments are the union of its sub-objects', tested against the same
@@ -75,27 +60,10 @@ enum class CullStage : std::uint8_t { Boxes, Objects, SubObjects };
 // and skip it for ExactBounds (R-CULLIDE on the emulator), where it only costs views.
 enum class ObjectStage : std::uint8_t { Auto, On, Off };
 inline constexpr double kDefaultMinPruneExactBounds = 0.5;
-[[nodiscard]] const char* to_string(CullStage s);
 
-// One orthographic view (both passes).
-struct ViewStats {
-    CullStage stage = CullStage::Boxes;
-    int axis = 0;                            // 0 x, 1 y, 2 z: the viewing direction
-    std::uint64_t items_before = 0;          // live items (objects or sub-objects) entering the view
-    std::uint64_t items_after = 0;           // live items after it
-    std::uint64_t queries = 0;               // occlusion queries issued (both passes)
-    std::uint64_t triangles_rasterized = 0;  // triangles submitted in draws (queries and writes)
-};
-
-// The most rounds of x, y, z views per stage a caller may ask for (max_rounds).
-inline constexpr int kMaxRounds = 1000;
-
-struct CullideOptions {
+// CULLIDE's options: the shared ones (visibility.h) and its own.
+struct CullideOptions : VisibilityOptions {
     VisibilityMode mode = VisibilityMode::GLExact;
-    int resolution = 1024;  // pixels per side of every view, 16..16384
-    raster::DepthFormat depth_format = raster::DepthFormat::D24;
-    int subobject_triangles = 4;  // triangles per sub-object, >= 1
-    int max_rounds = 4;           // rounds of three views per stage, 1..kMaxRounds
     // A view counts as unproductive when the triangles of the items it prunes are fewer than this
     // fraction of the stage's live triangles before it; a stage stops after three unproductive
     // views in a row (one per axis). 0: stop only when three views in a row prune nothing (the
@@ -104,28 +72,19 @@ struct CullideOptions {
     // the exact stage absorbs what they would have pruned) and 0 for GLExact and Offset.
     double min_prune = -1.0;      // < 1
     ObjectStage object_stage = ObjectStage::Auto;
-    int threads = 0;              // exact stage workers; 0 = all hardware threads
-    // ExactBounds on the emulator device: answer each view's two passes with one fused
-    // raster::VisibilityPass (raster/visibility.h: the same answers, bit for bit, at a quarter of the
-    // rasterization). The statistics still count the queries and triangles of the two recorded
-    // passes it replaces. false records and executes the passes (tests compare the two).
+    // ExactBounds: answer each view's two passes with the device's fused visibility pass
+    // (QueryDevice::visibility_pass: on the emulator raster::VisibilityPass, the same answers, bit
+    // for bit, at a quarter of the rasterization). The statistics still count the queries and
+    // triangles of the two recorded passes it replaces. false records and executes the passes
+    // (QueryDevice::recorded_visibility_pass; tests compare the two).
     bool fused_visibility = true;
 };
 
-struct CullideStats {
-    std::uint64_t objects_in = 0;       // objects entering the visibility stages
-    std::uint64_t pcs_boxes = 0;        // objects in the PCS after the box stage
-    std::uint64_t pcs_objects = 0;      // objects in the PCS after the triangle stage
-    std::uint64_t subobjects = 0;       // sub-objects entering the sub-object stage
-    std::uint64_t pcs_subobjects = 0;   // sub-objects left after it
+// The shared figures (visibility.h: pcs_boxes, pcs_objects, pcs_subobjects are the PCS after each
+// stage; candidate_triangles the triangles in the surviving sub-objects) and CULLIDE's own.
+struct CullideStats : VisibilityStats {
     std::uint64_t subobject_pairs = 0;  // sub-object pairs across objects holding a triangle pair
                                         // whose boxes overlap (a pair the exact stage tests)
-    std::uint64_t candidate_triangles = 0;  // triangles in the surviving sub-objects
-    std::uint64_t exact_tests = 0;      // triangle pairs sent to the exact test (boxes overlap)
-    std::uint64_t queries = 0;
-    std::uint64_t triangles_rasterized = 0;
-    std::vector<ViewStats> views;       // in the order they ran
-    double boxes_ms = 0, objects_ms = 0, subobjects_ms = 0, exact_ms = 0;
 };
 
 // Colliding triangle pairs found by CULLIDE among the objects listed in `active` (increasing

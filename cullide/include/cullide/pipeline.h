@@ -46,27 +46,19 @@ enum class BroadPhase { None, SpatialHash, SweepAndPrune, BruteForce };
 // Names accepted by parse_method, in order.
 [[nodiscard]] std::vector<std::string> method_names();
 
-// Default view resolution per method (pixels per side), measured (docs/cullide.md, "Defaults";
-// docs/quick-cullide.md): the exact-bounds methods (rcullide, qcullide) never miss, their cost falls
-// with the resolution and the exact stage removes the extra false positives, so they run best low;
-// the pixel-centre methods miss less at high resolution.
-inline constexpr int kDefaultResolutionRCullide = 32;
-inline constexpr int kDefaultResolutionQCullide = 32;
-inline constexpr int kDefaultResolutionOthers = 1024;
+// The method's default view resolution: default_resolution of its VisibilityMode (visibility.h),
+// 32 for rcullide and qcullide, 1024 for the others.
 [[nodiscard]] int default_resolution(Method m);
 
-struct RunOptions {
+// A run: the visibility methods' shared options (visibility.h: resolution, 0 = the method's
+// default_resolution; depth format; sub-object size; rounds; threads, which also drive the broad
+// phase, the exact method and the emulator) and the run's own. process_frame hands the shared part
+// to the method as it is.
+struct RunOptions : VisibilityOptions {
     Method method = Method::RCullide;  // R-CULLIDE (exact-bounds): never misses, ends in the exact test
-    int threads = 0;          // 0 = all hardware threads; results do not depend on it
-    // View resolution of the visibility methods (pixels per side), 1..16384; 0 = the method's own
-    // default_resolution (so choosing another method never silently keeps rcullide's 32 px).
-    int resolution = 0;
     bool self = false;        // also report pairs inside one object (adjacent triangles excluded);
                               // exact, qcullide and qcullide-gl only (CULLIDE never tests an object
                               // against itself)
-    raster::DepthFormat depth_format = raster::DepthFormat::D24;  // visibility methods
-    int subobject_triangles = 4;  // triangles per sub-object (visibility methods), >= 1
-    int max_rounds = 4;           // rounds of x, y, z views per visibility stage, >= 1
     double min_prune = -1.0;      // CullideOptions::min_prune (cullide, rcullide, rcullide-offset)
     ObjectStage object_stage = ObjectStage::Auto;  // CullideOptions::object_stage (same methods)
     BroadPhase broadphase = BroadPhase::None;  // with self on, no object is dropped by it
@@ -75,27 +67,21 @@ struct RunOptions {
     QueryDevice* device = nullptr;
 };
 
-// Per-frame figures. Counts are deterministic; times are wall-clock milliseconds.
-struct FrameStats {
+// Per-frame figures: the visibility methods' (visibility.h; zero for exact, which fills only
+// candidate_triangles, exact_tests and adjacent_skipped; with self-collision pcs_boxes and
+// pcs_objects are all objects: none leaves at object level) and the frame's own. Counts are
+// deterministic; times are wall-clock milliseconds.
+struct FrameStats : VisibilityStats {
     std::uint64_t objects = 0;
     std::uint64_t triangles = 0;
-    std::uint64_t candidate_triangles = 0;  // triangles surviving the object-box prefilter
-    std::uint64_t exact_tests = 0;          // triangle pairs sent to the exact test
-    std::uint64_t adjacent_skipped = 0;     // self pairs skipped because they share a (welded) vertex
     double time_ms = 0;
-    // Broad phase (all objects when none ran) and visibility stages (zero for exact; the PCS and
-    // per-view figures of cullide/cullide.h: pcs_* are the PCS after each stage).
+    // Broad phase (all objects when none ran).
     std::uint64_t broadphase_objects = 0;  // objects kept by the broad phase
     std::uint64_t broadphase_pairs = 0;    // overlapping object-box pairs it found
-    std::uint64_t pcs_boxes = 0;
-    std::uint64_t pcs_objects = 0;
-    std::uint64_t subobjects = 0;
-    std::uint64_t pcs_subobjects = 0;
+    double broadphase_ms = 0;
+    // Pieces paired for the exact stage: CULLIDE's sub-object pairs holding a tested triangle pair
+    // (CullideStats::subobject_pairs), Quick-CULLIDE's kept item pairs (QuickStats::item_pairs_kept).
     std::uint64_t subobject_pairs = 0;
-    std::uint64_t queries = 0;
-    std::uint64_t triangles_rasterized = 0;
-    std::vector<ViewStats> views;
-    double broadphase_ms = 0, boxes_ms = 0, objects_ms = 0, subobjects_ms = 0, exact_ms = 0;
 };
 
 struct FrameResult {

@@ -9,16 +9,25 @@
 //  - clear(width, height, format) makes a width x height depth target of `format` current and
 //    clears it to depth 1.0 (glClearDepth(1); glClear); the target may be reused between calls;
 //  - execute(batch) runs every command of the batch in order on the current target and returns
-//    the query results indexed like the batch's begin_query() calls (raster/command_batch.h).
+//    the query results indexed like the batch's begin_query() calls (raster/command_batch.h);
+//  - visibility_pass(size, format, items) answers CULLIDE's two exact-bounds passes of one view
+//    (raster/visibility.h). Every device can: the base class records the two passes and runs them
+//    with clear and execute (recorded_visibility_pass); the emulator answers them natively with
+//    raster::VisibilityPass, the same answers bit for bit at a quarter of the rasterization.
 // Results must not depend on the thread count (the emulator's are bit-identical for any count).
 #pragma once
 
+#include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "cullide/result.h"
+#include "cullide/visibility.h"
 #include "raster/command_batch.h"
 #include "raster/types.h"
+#include "raster/visibility.h"
 
 namespace cullide {
 
@@ -35,6 +44,20 @@ class QueryDevice {
     [[nodiscard]] virtual Result<raster::QueryResults> execute(const raster::CommandBatch& batch) = 0;
     // For reports: "emulator", "osmesa (llvmpipe ...)".
     [[nodiscard]] virtual std::string name() const = 0;
+
+    // For each item, 1 when one of its two recorded queries passes a sample, 0 when it is fully
+    // visible with respect to every other object's items (raster/visibility.h), on a target of
+    // `size` and `format`. Items are listed in pass-1 order with their objects' items consecutive
+    // (VisibilityItem::object non-decreasing). Pass 1 runs the objects forward, pass 2 backward;
+    // per object: query each item (exact-bounds, GEQUAL, mask off), then write them (LEQUAL, mask
+    // on), except after the pass's last object. Fails as clear and execute fail, or on invalid
+    // items (naming the item). The default is recorded_visibility_pass; an override must give
+    // the same answers.
+    [[nodiscard]] virtual Result<std::vector<std::uint8_t>> visibility_pass(ViewSize size, raster::DepthFormat format,
+                                                                            std::span<const raster::VisibilityItem> items);
+    // The two passes recorded as command batches and run with clear and execute.
+    [[nodiscard]] Result<std::vector<std::uint8_t>> recorded_visibility_pass(
+        ViewSize size, raster::DepthFormat format, std::span<const raster::VisibilityItem> items);
 };
 
 // The built-in device: raster::execute on a raster::DepthTarget, on `threads` worker threads

@@ -46,51 +46,41 @@
 #include <span>
 #include <vector>
 
-#include "cullide/cullide.h"
 #include "cullide/ground_truth.h"
 #include "cullide/mesh.h"
 #include "cullide/query_device.h"
 #include "cullide/result.h"
+#include "cullide/visibility.h"
 
 namespace cullide {
 
-struct QuickOptions {
+// Quick-CULLIDE's options: the shared ones (visibility.h) and its own.
+struct QuickOptions : VisibilityOptions {
     // ExactBounds (reliable, emulator only) or GLExact (pixel centres, may miss like the GPU).
     // Offset is refused.
     VisibilityMode mode = VisibilityMode::ExactBounds;
     bool self = false;  // also pairs inside one object (welded-adjacent triangles excluded)
-    int resolution = 1024;
-    raster::DepthFormat depth_format = raster::DepthFormat::D24;
-    int subobject_triangles = 4;  // >= 1
-    int max_rounds = 4;           // >= 1
-    int threads = 0;              // exact stage workers; 0 = all hardware threads
     // Benchmarks only: skip the visibility passes (every item stays NFV), which leaves the
     // box-prefiltered all-pairs test (sweep and prune on item boxes, then triangle boxes, adjacency,
     // exact test): the peer the culling is measured against.
     bool skip_visibility = false;
 };
 
-struct QuickStats {
-    std::uint64_t objects_in = 0;
-    std::uint64_t pcs_boxes = 0;        // not BFV after the box stage (self off: object boxes through
-                                        // the passes; self on: item boxes by sweep and prune)
-    std::uint64_t pcs_objects = 0;      // after the object stage (self off)
-    std::uint64_t subobjects = 0;       // items entering the sub-object stage
-    std::uint64_t pcs_subobjects = 0;   // not BFV after it
+// The shared figures (visibility.h) read as follows, and Quick-CULLIDE's own:
+//  pcs_boxes       not BFV after the box stage (self off: object boxes through the passes; self on:
+//                  item boxes by sweep and prune)
+//  pcs_objects     after the object stage (self off)
+//  subobjects, pcs_subobjects  items entering the sub-object stage, not BFV after it
+//  candidate_triangles  triangles in kept item pairs (counted per item once)
+//  subobjects_ms   includes the triangle stage
+struct QuickStats : VisibilityStats {
     std::uint64_t triangles_in = 0;     // items entering the triangle stage (self off, sub-objects > 1)
     std::uint64_t pcs_triangles = 0;    // not BFV after it
     std::uint64_t window_max = 0;       // largest self window W over the objects (items)
     std::uint64_t item_pairs = 0;       // item pairs with overlapping boxes (sweep and prune)
     std::uint64_t item_pairs_kept = 0;  // of those, not proven apart by tags (sent on)
     std::uint64_t near_item_pairs = 0;  // of the kept, near pairs (self window)
-    std::uint64_t candidate_triangles = 0;  // triangles in kept item pairs (counted per item once)
-    std::uint64_t exact_tests = 0;      // triangle pairs sent to the exact test
-    std::uint64_t near_exact_tests = 0; // of those, from near item pairs
-    std::uint64_t adjacent_skipped = 0; // self pairs with overlapping boxes skipped as adjacent
-    std::uint64_t queries = 0;
-    std::uint64_t triangles_rasterized = 0;
-    std::vector<ViewStats> views;
-    double boxes_ms = 0, objects_ms = 0, subobjects_ms = 0, exact_ms = 0;  // triangle stage in subobjects_ms
+    std::uint64_t near_exact_tests = 0; // of exact_tests, from near item pairs
 };
 
 // Colliding triangle pairs found by Quick-CULLIDE among the objects listed in `active` (increasing

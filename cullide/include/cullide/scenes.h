@@ -2,7 +2,7 @@
 //
 // A scene is a function of (options, frame index): frame f can be generated without frames
 // 0..f-1, and the same options give the same bits on every platform and thread count (only
-// IEEE-exact operations: + - * / sqrt; the trigonometry is our own, see det_math.h).
+// IEEE-exact operations: + - * / sqrt; the trigonometry is our own, see scene_math.h).
 #pragma once
 
 #include <cstdint>

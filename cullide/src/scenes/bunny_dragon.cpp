@@ -13,7 +13,7 @@
 #include <system_error>
 
 #include "cullide/mesh_io.h"
-#include "det_math.h"
+#include "scene_math.h"
 #include "scenes/scene_kit.h"
 
 namespace cullide::scene_kit {

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <string>
 
-#include "det_math.h"
+#include "scene_math.h"
 #include "scenes/scene_kit.h"
 
 namespace cullide::scene_kit {

@@ -7,7 +7,7 @@
 // kPeriod (the motion loops seamlessly) and arguments of det_sin never grow.
 #include <string>
 
-#include "det_math.h"
+#include "scene_math.h"
 #include "scenes/scene_kit.h"
 
 namespace cullide::scene_kit {

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "det_math.h"
+#include "scene_math.h"
 
 namespace cullide::scene_kit {
 

@@ -1,6 +1,6 @@
 // scene_kit.h: geometry helpers and per-scene factories shared by the scene generators.
 //
-// Private to cullide_lib. Every helper uses only + - * / sqrt and det_math.h, in a fixed order, so a
+// Private to cullide_lib. Every helper uses only + - * / sqrt and scene_math.h, in a fixed order, so a
 // scene's bits are the same on every platform (see docs/scenes.md, "Determinism").
 #pragma once
 
@@ -27,7 +27,7 @@ struct Rotation {
     Vec3 u{1, 0, 0}, v{0, 1, 0}, w{0, 0, 1};
 };
 [[nodiscard]] Vec3 apply(const Rotation& r, Vec3 p);
-// Rz(yaw) * Ry(pitch) * Rx(roll), angles in radians, trigonometry from det_math.h.
+// Rz(yaw) * Ry(pitch) * Rx(roll), angles in radians, trigonometry from scene_math.h.
 [[nodiscard]] Rotation rotation_from_angles(double yaw, double pitch, double roll);
 // Rotation by `angle` about the unit axis (Rodrigues' formula).
 [[nodiscard]] Rotation rotation_about(Vec3 axis, double angle);

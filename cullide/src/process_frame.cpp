@@ -1,3 +1,5 @@
+// process_frame.cpp: one frame through a method (cullide/pipeline.h), and the names of methods,
+// broad phases and depth formats.
 #include "cullide/pipeline.h"
 
 #include <chrono>
@@ -66,6 +68,78 @@ Result<std::vector<std::uint32_t>> broad_phase(std::span<const Mesh> objects, co
     return active;
 }
 
+// The exact method on the kept objects only; their indices map back in order, so the list stays
+// sorted.
+Status run_exact(std::span<const Mesh> objects, const std::vector<std::uint32_t>& active, const RunOptions& o,
+                 FrameResult& result) {
+    std::vector<Mesh> kept_storage;
+    std::span<const Mesh> kept = objects;
+    const bool all = active.size() == objects.size();
+    if (!all) {
+        for (std::uint32_t i : active) kept_storage.push_back(objects[i]);
+        kept = kept_storage;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    ExactStats es;
+    Result<std::vector<TrianglePair>> pairs = exact_pairs(kept, ExactOptions{o.self, o.threads}, &es);
+    if (!pairs) return pairs.error();
+    result.pairs = std::move(pairs).value();
+    if (!all) {
+        for (TrianglePair& p : result.pairs) {
+            p.object_a = active[p.object_a];
+            p.object_b = active[p.object_b];
+        }
+    }
+    FrameStats& st = result.stats;
+    st.candidate_triangles = es.candidate_triangles;
+    st.exact_tests = es.box_pairs;
+    st.adjacent_skipped = es.adjacent_skipped;
+    st.exact_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return Status{};
+}
+
+// A visibility method: the run's shared options go to the method as they are (VisibilityOptions,
+// visibility.h), its shared statistics come back as they are (VisibilityStats); the resolution is
+// checked and defaulted by the method's entry point.
+Status run_visibility(std::span<const Mesh> objects, const std::vector<std::uint32_t>& active, const RunOptions& o,
+                      FrameResult& result) {
+    std::unique_ptr<QueryDevice> own;
+    QueryDevice* device = o.device;
+    if (device == nullptr) {
+        own = make_emulator_device(o.threads);
+        device = own.get();
+    }
+    FrameStats& st = result.stats;
+    Result<std::vector<TrianglePair>> pairs = Error{};
+    if (o.method == Method::QCullide || o.method == Method::QCullideGL) {
+        QuickOptions qo;
+        static_cast<VisibilityOptions&>(qo) = o;
+        qo.mode = o.method == Method::QCullide ? VisibilityMode::ExactBounds : VisibilityMode::GLExact;
+        qo.self = o.self;
+        QuickStats qs;
+        pairs = quick_cullide_pairs(objects, active, qo, *device, &qs);
+        static_cast<VisibilityStats&>(st) = std::move(qs);
+        st.subobject_pairs = qs.item_pairs_kept;
+        // With self-collision no object leaves at object level (it may collide with itself).
+        if (o.self) st.pcs_boxes = st.pcs_objects = st.objects_in;
+    } else {
+        CullideOptions co;
+        static_cast<VisibilityOptions&>(co) = o;
+        co.mode = o.method == Method::Cullide    ? VisibilityMode::GLExact
+                  : o.method == Method::RCullide ? VisibilityMode::ExactBounds
+                                                 : VisibilityMode::Offset;
+        co.min_prune = o.min_prune;
+        co.object_stage = o.object_stage;
+        CullideStats cs;
+        pairs = cullide_pairs(objects, active, co, *device, &cs);
+        static_cast<VisibilityStats&>(st) = std::move(cs);
+        st.subobject_pairs = cs.subobject_pairs;
+    }
+    if (!pairs) return pairs.error();
+    result.pairs = std::move(pairs).value();
+    return Status{};
+}
+
 }  // namespace
 
 const char* to_string(Method m) { return name_of(m, kMethods); }
@@ -85,9 +159,17 @@ Result<raster::DepthFormat> parse_depth_format(std::string_view name) {
 }
 
 int default_resolution(Method m) {
-    return m == Method::RCullide   ? kDefaultResolutionRCullide
-           : m == Method::QCullide ? kDefaultResolutionQCullide
-                                   : kDefaultResolutionOthers;
+    switch (m) {
+        case Method::RCullide:
+        case Method::QCullide:
+            return default_resolution(VisibilityMode::ExactBounds);
+        case Method::Exact:
+        case Method::Cullide:
+        case Method::RCullideOffset:
+        case Method::QCullideGL:
+            break;
+    }
+    return kDefaultResolutionOthers;
 }
 
 Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOptions& options) {
@@ -114,114 +196,9 @@ Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOption
     st.broadphase_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - bp_start).count();
 
-    switch (options.method) {
-        case Method::Exact: {
-            // The exact method on the kept objects only; their indices map back in order, so the
-            // list stays sorted.
-            std::vector<Mesh> kept_storage;
-            std::span<const Mesh> kept = objects;
-            const bool all = active.value().size() == objects.size();
-            if (!all) {
-                for (std::uint32_t i : active.value()) kept_storage.push_back(objects[i]);
-                kept = kept_storage;
-            }
-            const auto t0 = std::chrono::steady_clock::now();
-            ExactStats es;
-            Result<std::vector<TrianglePair>> pairs = exact_pairs(kept, ExactOptions{options.self, options.threads}, &es);
-            if (!pairs) return pairs.error();
-            result.pairs = std::move(pairs).value();
-            if (!all) {
-                for (TrianglePair& p : result.pairs) {
-                    p.object_a = active.value()[p.object_a];
-                    p.object_b = active.value()[p.object_b];
-                }
-            }
-            st.candidate_triangles = es.candidate_triangles;
-            st.exact_tests = es.box_pairs;
-            st.adjacent_skipped = es.adjacent_skipped;
-            st.exact_ms =
-                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-            break;
-        }
-        case Method::Cullide:
-        case Method::RCullide:
-        case Method::RCullideOffset: {
-            CullideOptions co;
-            co.mode = options.method == Method::Cullide    ? VisibilityMode::GLExact
-                      : options.method == Method::RCullide ? VisibilityMode::ExactBounds
-                                                           : VisibilityMode::Offset;
-            co.resolution = options.resolution == 0 ? default_resolution(options.method) : options.resolution;
-            co.depth_format = options.depth_format;
-            co.subobject_triangles = options.subobject_triangles;
-            co.max_rounds = options.max_rounds;
-            co.min_prune = options.min_prune;
-            co.object_stage = options.object_stage;
-            co.threads = options.threads;
-            std::unique_ptr<QueryDevice> own;
-            QueryDevice* device = options.device;
-            if (device == nullptr) {
-                own = make_emulator_device(options.threads);
-                device = own.get();
-            }
-            CullideStats cs;
-            Result<std::vector<TrianglePair>> pairs = cullide_pairs(objects, active.value(), co, *device, &cs);
-            if (!pairs) return pairs.error();
-            result.pairs = std::move(pairs).value();
-            st.candidate_triangles = cs.candidate_triangles;
-            st.exact_tests = cs.exact_tests;
-            st.pcs_boxes = cs.pcs_boxes;
-            st.pcs_objects = cs.pcs_objects;
-            st.subobjects = cs.subobjects;
-            st.pcs_subobjects = cs.pcs_subobjects;
-            st.subobject_pairs = cs.subobject_pairs;
-            st.queries = cs.queries;
-            st.triangles_rasterized = cs.triangles_rasterized;
-            st.views = std::move(cs.views);
-            st.boxes_ms = cs.boxes_ms;
-            st.objects_ms = cs.objects_ms;
-            st.subobjects_ms = cs.subobjects_ms;
-            st.exact_ms = cs.exact_ms;
-            break;
-        }
-        case Method::QCullide:
-        case Method::QCullideGL: {
-            QuickOptions qo;
-            qo.mode = options.method == Method::QCullide ? VisibilityMode::ExactBounds : VisibilityMode::GLExact;
-            qo.self = options.self;
-            qo.resolution = options.resolution == 0 ? default_resolution(options.method) : options.resolution;
-            qo.depth_format = options.depth_format;
-            qo.subobject_triangles = options.subobject_triangles;
-            qo.max_rounds = options.max_rounds;
-            qo.threads = options.threads;
-            std::unique_ptr<QueryDevice> own;
-            QueryDevice* device = options.device;
-            if (device == nullptr) {
-                own = make_emulator_device(options.threads);
-                device = own.get();
-            }
-            QuickStats qs;
-            Result<std::vector<TrianglePair>> pairs = quick_cullide_pairs(objects, active.value(), qo, *device, &qs);
-            if (!pairs) return pairs.error();
-            result.pairs = std::move(pairs).value();
-            st.candidate_triangles = qs.candidate_triangles;
-            st.exact_tests = qs.exact_tests;
-            st.adjacent_skipped = qs.adjacent_skipped;
-            // With self-collision no object leaves at object level (it may collide with itself).
-            st.pcs_boxes = options.self ? qs.objects_in : qs.pcs_boxes;
-            st.pcs_objects = options.self ? qs.objects_in : qs.pcs_objects;
-            st.subobjects = qs.subobjects;
-            st.pcs_subobjects = qs.pcs_subobjects;
-            st.subobject_pairs = qs.item_pairs_kept;
-            st.queries = qs.queries;
-            st.triangles_rasterized = qs.triangles_rasterized;
-            st.views = std::move(qs.views);
-            st.boxes_ms = qs.boxes_ms;
-            st.objects_ms = qs.objects_ms;
-            st.subobjects_ms = qs.subobjects_ms;
-            st.exact_ms = qs.exact_ms;
-            break;
-        }
-    }
+    Status ran = options.method == Method::Exact ? run_exact(objects, active.value(), options, result)
+                                                 : run_visibility(objects, active.value(), options, result);
+    if (!ran) return ran.error();
     result.object_pairs = object_pairs(result.pairs);
     st.objects = objects.size();
     st.time_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

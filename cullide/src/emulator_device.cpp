@@ -1,10 +1,11 @@
-// cullide_device.cpp: the emulator QueryDevice (raster::execute on a raster::DepthTarget).
+// emulator_device.cpp: the built-in QueryDevice, raster::execute on a raster::DepthTarget, with the
+// fused visibility pass (raster::VisibilityPass) as its native visibility_pass.
 #include <optional>
 
 #include "cullide/query_device.h"
-#include "emulator_device.h"
 #include "parallel.h"
 #include "raster/depth_target.h"
+#include "raster/visibility.h"
 
 namespace cullide {
 namespace {
@@ -33,8 +34,20 @@ class EmulatorDevice final : public QueryDevice {
         return std::move(r).value();
     }
 
+    // Both passes in one rasterization per item (raster/visibility.h), bit-identical to the
+    // recorded passes (tests/cullide/fused_visibility_test.cpp).
+    Result<std::vector<std::uint8_t>> visibility_pass(ViewSize size, raster::DepthFormat format,
+                                                      std::span<const raster::VisibilityItem> items) override {
+        // One per calling thread, shared by every device and frame: process_frame makes a device
+        // per frame, and a pass owned by the device would fault its buffers in afresh each frame.
+        // It keeps no answer from one call to the next, so results cannot depend on what ran before.
+        thread_local raster::VisibilityPass pass;
+        raster::Result<std::vector<std::uint8_t>> r = pass.run(size.width(), size.height(), format, items, threads_);
+        if (!r) return Error{"emulator device: " + r.error().message};
+        return std::move(r).value();
+    }
+
     std::string name() const override { return "emulator"; }
-    int threads() const { return threads_; }
 
    private:
     int threads_;
@@ -42,11 +55,6 @@ class EmulatorDevice final : public QueryDevice {
 };
 
 }  // namespace
-
-int detail::emulator_threads(const QueryDevice& device) {
-    const auto* e = dynamic_cast<const EmulatorDevice*>(&device);
-    return e != nullptr ? e->threads() : -1;
-}
 
 std::unique_ptr<QueryDevice> make_emulator_device(int threads) { return std::make_unique<EmulatorDevice>(threads); }
 

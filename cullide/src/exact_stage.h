@@ -1,0 +1,133 @@
+// exact_stage.h (private): the one exact stage every method ends in, and the one sweep and prune.
+//
+// Input: candidate sets (runs of one object's triangles with a box: a whole mesh's triangles one by
+// one for the ground truth, live sub-objects for CULLIDE, tagged items for Quick-CULLIDE) and which
+// pairs of sets to look at: either every pair whose boxes overlap (`sweep_exact_stage`, swept per
+// pair of overlapping objects) or a list the caller already filtered (`listed_exact_stage`). Output:
+// the colliding triangle pairs, canonical and sorted (ground_truth.h), and counts. A triangle pair
+// is tested exactly (tri_tri.h) when its two boxes overlap and, inside one object, when the two
+// triangles share no welded vertex (adjacent: counted, never tested).
+//
+// Deterministic: work is cut into units fixed by the input (kSweepChunk refs of a task's sorted
+// list, kPairChunk listed pairs), units run on up to `threads` workers (cullide/src/parallel.h), and
+// the outputs are merged in unit order and sorted on unique keys. This is the place to make the
+// exact stage fast; callers only say which sets may meet.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "cullide/ground_truth.h"
+#include "cullide/mesh.h"
+
+namespace cullide::detail {
+
+// ---- The sweep and prune -------------------------------------------------------------------------
+
+// A box in a sweep: a whole candidate set (part == kWholeSet) or one triangle (part = its position
+// in its object). (set, part) makes the sort key unique (ties on the box are broken by it), so the
+// order, and anything merged in it, does not depend on the sort algorithm.
+inline constexpr std::uint32_t kWholeSet = 0xffffffffu;
+struct SweepRef {
+    Aabb box;
+    std::uint32_t object = 0;  // pairs of one object are skipped unless the sweep allows them
+    std::uint32_t set = 0;
+    std::uint32_t part = kWholeSet;
+};
+
+// The axis where the boxes' centres spread most (a sweep along it meets the fewest false overlaps).
+[[nodiscard]] int spread_axis(std::span<const SweepRef> refs);
+// Sorts `refs` by (box.lo[axis], set, part).
+void sort_along(std::vector<SweepRef>& refs, int axis);
+
+// Calls visit(refs[i], refs[j]) for every i in [begin, end) and j > i whose boxes overlap, `refs`
+// sorted by sort_along(axis); refs of one object only when `same_object`. Any [begin, end) split of
+// the list visits each pair once. The object test comes before the box test: it is one integer
+// compare, and in a task of two objects half the refs the sweep meets are the same object's.
+template <class Visit>
+void sweep_overlaps(std::span<const SweepRef> refs, int axis, std::size_t begin, std::size_t end, bool same_object,
+                    Visit&& visit) {
+    for (std::size_t i = begin; i < end; ++i) {
+        const SweepRef& a = refs[i];
+        const double a_hi = a.box.hi[axis];
+        for (std::size_t j = i + 1; j < refs.size() && refs[j].box.lo[axis] <= a_hi; ++j) {
+            if (!same_object && refs[j].object == a.object) continue;
+            if (overlaps(a.box, refs[j].box)) visit(a, refs[j]);
+        }
+    }
+}
+
+// Pairs (a < b) of the `set` values of `refs` whose boxes overlap (any objects), sorted. `refs` is
+// sorted here, along its spread axis.
+[[nodiscard]] std::vector<std::pair<std::uint32_t, std::uint32_t>> overlapping_sets(std::vector<SweepRef> refs,
+                                                                                    int threads);
+
+// ---- The exact stage -----------------------------------------------------------------------------
+
+// One object's triangles as the exact stage reads them: position p is mesh triangle order[p]
+// (p itself when `order` is empty), with box triangle_boxes[p]. Spans must outlive the call.
+struct ExactObject {
+    const Mesh* mesh = nullptr;
+    std::uint32_t object = 0;              // reported in the pairs (index into the caller's objects)
+    Aabb box;                              // holds every set of the object (sweep_exact_stage's tasks)
+    std::span<const Aabb> triangle_boxes;  // by position; sweep_exact_stage never reads it when every
+                                           // set of the object holds one triangle (the set's box is
+                                           // the triangle's), so it may be empty then
+    std::span<const std::uint32_t> order;  // mesh triangle by position; empty: the identity
+    std::span<const std::uint32_t> weld;   // welded vertex ids (weld_vertices); needed for self pairs
+};
+
+// Positions [first, first + count) of exact object `object` (an index into the ExactObject list);
+// `box` holds their triangle boxes. Sets of one object are listed consecutively, objects in order.
+struct CandidateSet {
+    std::uint32_t object = 0;
+    std::uint32_t first = 0, count = 0;
+    Aabb box;
+};
+
+// Two sets to test against each other (a <= b; a == b: the set's own triangle pairs). `near`
+// only feeds ExactStageStats::near_tests.
+struct CandidatePair {
+    std::uint32_t a = 0, b = 0;
+    bool near = false;
+};
+
+struct ExactStageStats {
+    std::uint64_t task_triangles = 0;  // sweep: triangles of sets meeting the common box of two
+                                       // overlapping objects (every set's with self)
+    std::uint64_t tests = 0;           // triangle pairs sent to the exact test
+    std::uint64_t near_tests = 0;      // listed: of those, from near pairs
+    std::uint64_t adjacent_skipped = 0;
+    std::uint64_t set_pairs = 0;       // sweep with count_set_pairs: set pairs holding a tested pair
+};
+
+struct ExactStageResult {
+    std::vector<TrianglePair> pairs;  // canonical, sorted, unique
+    ExactStageStats stats;
+};
+
+struct SweepOptions {
+    bool self = false;              // pairs of one object's sets too (one task per object)
+    bool count_set_pairs = false;   // fill ExactStageStats::set_pairs
+    int threads = 0;
+};
+
+// Every triangle pair of overlapping boxes from sets of two objects whose boxes overlap (and of one
+// object with `self`). One task per such pair of objects holds the sets meeting the two boxes'
+// intersection (no pair outside it can meet) and is swept on its own; it sweeps the triangles
+// instead of the sets when the sets are loose (their boxes' summed extent along the axis is more
+// than 4 times their triangles': consecutive triangles of a scrambled or thinned mesh lie far apart,
+// and a set sweep would meet more overlaps than a triangle sweep). The pairs tested are the same
+// either way. A self task (one object's sets) always sweeps its triangles.
+[[nodiscard]] ExactStageResult sweep_exact_stage(std::span<const ExactObject> objects,
+                                                 std::span<const CandidateSet> sets, const SweepOptions& options);
+
+// The triangle pairs of exactly the listed set pairs.
+[[nodiscard]] ExactStageResult listed_exact_stage(std::span<const ExactObject> objects,
+                                                  std::span<const CandidateSet> sets,
+                                                  std::span<const CandidatePair> pairs, int threads);
+
+}  // namespace cullide::detail

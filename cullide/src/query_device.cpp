@@ -1,0 +1,58 @@
+// query_device.cpp: what every QueryDevice can do through clear and execute (the recorded
+// visibility pass).
+#include "cullide/query_device.h"
+
+#include <string>
+#include <utility>
+
+namespace cullide {
+
+Result<std::vector<std::uint8_t>> QueryDevice::visibility_pass(ViewSize size, raster::DepthFormat format,
+                                                               std::span<const raster::VisibilityItem> items) {
+    return recorded_visibility_pass(size, format, items);
+}
+
+Result<std::vector<std::uint8_t>> QueryDevice::recorded_visibility_pass(
+    ViewSize size, raster::DepthFormat format, std::span<const raster::VisibilityItem> items) {
+    // Each object's items: [begin, end) runs of equal VisibilityItem::object.
+    std::vector<std::pair<std::size_t, std::size_t>> objects;
+    for (std::size_t b = 0; b < items.size();) {
+        std::size_t e = b;
+        while (e < items.size() && items[e].object == items[b].object) ++e;
+        objects.emplace_back(b, e);
+        b = e;
+    }
+    raster::DrawState query_state;
+    query_state.mode = raster::RasterMode::ExactBounds;
+    query_state.depth_func = raster::DepthFunc::GEqual;
+    query_state.depth_write = false;
+    raster::DrawState write_state = query_state;
+    write_state.depth_func = raster::DepthFunc::LEqual;
+    write_state.depth_write = true;
+
+    std::vector<std::uint8_t> passed(items.size(), 0);
+    std::vector<std::uint32_t> query(items.size());
+    for (int pass = 0; pass < 2; ++pass) {  // pass 1 forward, pass 2 backward
+        raster::CommandBatch batch(size.width(), size.height());
+        for (std::size_t k = 0; k < objects.size(); ++k) {
+            const auto [begin, end] = objects[pass == 0 ? k : objects.size() - 1 - k];
+            for (std::size_t i = begin; i < end; ++i) {
+                query[i] = batch.begin_query(raster::QueryKind::AnySamplesPassed);
+                batch.draw(items[i].mesh, query_state);
+                batch.end_query();
+            }
+            if (k + 1 == objects.size()) continue;  // nothing is queried after the last object
+            for (std::size_t i = begin; i < end; ++i) batch.draw(items[i].mesh, write_state);
+        }
+        if (Status s = clear(size.width(), size.height(), format); !s) return s.error();
+        Result<raster::QueryResults> r = execute(batch);
+        if (!r) return r.error();
+        if (r.value().size() != batch.query_kinds().size())
+            return Error{name() + " returned " + std::to_string(r.value().size()) + " query results for " +
+                         std::to_string(batch.query_kinds().size()) + " queries"};
+        for (std::size_t i = 0; i < items.size(); ++i) passed[i] |= r.value()[query[i]] != 0 ? 1 : 0;
+    }
+    return passed;
+}
+
+}  // namespace cullide
