@@ -261,10 +261,10 @@ SceneFrames scene_frames(const BenchArgs& a, const std::string& scene, double sc
         sf.index.push_back(a.first_frame + k * a.frame_step);
         sf.frames.push_back(g.value()->frame(sf.index.back()));
     }
-    PipelineSettings exact = a.base;
+    RunOptions exact = a.base;
     exact.method = Method::Exact;
     for (std::size_t f = 0; f < sf.frames.size(); ++f) {
-        Result<FrameResult> r = process_frame(sf.frames[f], to_run_options(exact));
+        Result<FrameResult> r = process_frame(sf.frames[f], exact);
         if (!r) {
             throw RunFailure{"scene " + scene + " frame " + std::to_string(sf.index[f]) +
                              ": ground truth: " + r.error().message};
@@ -331,12 +331,11 @@ void accumulate(CaseResult& c, const FrameRun& fr, const Comparison& cmp, std::s
 // misses in bench, while sweep records it as MISMATCH (stderr and `mismatch`) and goes on.
 CaseResult run_case(const BenchArgs& a, const FrameRunner& runner, const SceneFrames& sf, CaseResult c,
                     std::ostream& err, bool& mismatch) {
-    PipelineSettings p = a.base;
-    p.method = c.method;
-    p.resolution = c.resolution;
-    p.depth_format = c.depth_format;
-    p.threads = c.threads;
-    const RunOptions o = to_run_options(p);
+    RunOptions o = a.base;
+    o.method = c.method;
+    o.resolution = c.resolution;
+    o.depth_format = c.depth_format;
+    o.threads = c.threads;
     bool misses = false;
     for (std::size_t f = 0; f < sf.frames.size(); ++f) {
         const std::string where = "scene " + c.scene + " (scale " + std::to_string(c.scale) + "), method " +

@@ -29,7 +29,7 @@ struct BenchArgs {
     int frame_step = 1;
     int warmup = 0;
     int reps = 0;
-    PipelineSettings base;  // subobject, rounds, min-prune, object stage, broadphase, self
+    RunOptions base;        // subobject, rounds, min-prune, object stage, broadphase, self
     SceneOptions scene_options;
     std::string csv_path, json_path;
     bool progress = true;

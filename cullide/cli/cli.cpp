@@ -50,10 +50,10 @@ struct RunArgs {
 // run's own defaults, after the table's: --self without --method runs qcullide, and a method without
 // --resolution runs at its default_resolution (printed, so the text and JSON show the real figure).
 RunArgs run_args_of(const Settings& s) {
-    PipelineSettings p = s.pipeline;
-    if (p.self && !p.method_given) p.method = Method::QCullide;
+    RunOptions p = s.pipeline;
+    if (p.self && !s.method_given) p.method = Method::QCullide;
     if (p.resolution == 0) p.resolution = default_resolution(p.method);
-    return RunArgs{s.inputs, to_run_options(p), s.frames, s.pairs_file, s.json, s.scene};
+    return RunArgs{s.inputs, p, s.frames, s.pairs_file, s.json, s.scene};
 }
 
 bool is_builtin(const std::string& name) {

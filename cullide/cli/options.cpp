@@ -200,7 +200,7 @@ void add_run_options(std::vector<OptionSpec>& t) {
          "",
          [](const OptionSpec& o, const std::string& v, Settings& s) {
              s.pipeline.method = checked(o, parse_method(v));
-             s.pipeline.method_given = true;
+             s.method_given = true;
          }});
     t.push_back({"--frames", "N", kRunOnly, "frames to run", integers(1, 1000000),
                  "10 for built-in scenes, 1 for files", "",
@@ -413,21 +413,6 @@ std::string command_list(CommandSet set) {
         s += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + names[i];
     }
     return s;
-}
-
-RunOptions to_run_options(const PipelineSettings& p) {
-    RunOptions o;
-    o.method = p.method;
-    o.threads = p.threads;
-    o.resolution = p.resolution;
-    o.self = p.self;
-    o.depth_format = p.depth_format;
-    o.subobject_triangles = p.subobject_triangles;
-    o.max_rounds = p.max_rounds;
-    o.min_prune = p.min_prune;
-    o.object_stage = p.object_stage;
-    o.broadphase = p.broadphase;
-    return o;
 }
 
 const std::vector<OptionSpec>& option_table() {

@@ -33,30 +33,15 @@ struct UsageError {
     std::string message;
 };
 
-// The pipeline knobs every command shares; what RunOptions is built from. Bench and sweep cross the
-// method, resolution, depth format and thread count with their lists, per combination.
-struct PipelineSettings {
-    Method method = RunOptions{}.method;
-    bool method_given = false;  // run: --self without --method runs qcullide
-    int threads = RunOptions{}.threads;
-    int resolution = 0;  // 0: the method's default_resolution
-    raster::DepthFormat depth_format = RunOptions{}.depth_format;
-    int subobject_triangles = RunOptions{}.subobject_triangles;
-    int max_rounds = RunOptions{}.max_rounds;
-    double min_prune = RunOptions{}.min_prune;
-    ObjectStage object_stage = RunOptions{}.object_stage;
-    BroadPhase broadphase = RunOptions{}.broadphase;
-    bool self = RunOptions{}.self;
-};
-
-// The one place that knows RunOptions' fields: a change to RunOptions (say, the resolution becoming
-// another type) is absorbed here, not in the table or the commands.
-[[nodiscard]] RunOptions to_run_options(const PipelineSettings& p);
-
 // Everything the options of run, bench and sweep set. Empty lists and unset optionals mean "the
 // command's default" (the commands fill them in after parsing).
 struct Settings {
-    PipelineSettings pipeline;
+    // The pipeline knobs every command shares, straight into the RunOptions that reaches
+    // process_frame (no second struct to copy); resolution 0 = the method's default_resolution.
+    // Bench and sweep cross the method, resolution, depth format and thread count with their
+    // lists, per combination.
+    RunOptions pipeline;
+    bool method_given = false;  // run: --self without --method runs qcullide
     SceneOptions scene;
     bool help = false;  // --help / -h anywhere: print the command's help and nothing else
     std::optional<int> frames;
