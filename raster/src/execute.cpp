@@ -66,7 +66,7 @@ Result<QueryResults> execute_reference(DepthTarget& target, const CommandBatch& 
     std::vector<detail::SetupTri> tris;
     std::vector<detail::BoundsTri> btris;
     std::vector<detail::BoundsVertex> bpool;
-    std::uint32_t* depth = target.mutable_values().data();
+    const detail::DepthRows depth{target.mutable_values().data(), target.width()};
     const auto& cmds = batch.commands();
     for (std::size_t i = 0; i < cmds.size(); ++i) {
         const Command& c = cmds[i];
@@ -79,15 +79,14 @@ Result<QueryResults> execute_reference(DepthTarget& target, const CommandBatch& 
             continue;
         }
         const detail::FrontEndParams p = params_for(target, c.state);
+        const detail::DepthState depth_state{target.format(), c.state.depth_func, c.state.depth_write};
         if (c.state.mode == RasterMode::ExactBounds) {
             btris.clear();
             bpool.clear();
             setup_bounds_draw(p, c, static_cast<std::uint32_t>(i), btris, bpool);
             for (const auto& t : btris) {
-                const std::uint64_t passed = detail::bounds_rect(t, bpool.data(), target.format(),
-                                                                 c.state.depth_func,
-                                                                 c.state.depth_write, depth, target.width(), t.x0,
-                                                                 t.y0, t.x1, t.y1);
+                const std::uint64_t passed =
+                    detail::bounds_rect(t, bpool.data(), depth_state, depth, {t.x0, t.y0, t.x1, t.y1});
                 if (active != kNoQuery) results[active] += passed;
             }
             continue;
@@ -99,9 +98,8 @@ Result<QueryResults> execute_reference(DepthTarget& target, const CommandBatch& 
             detail::setup_triangle(p, vtx[idx[k]], vtx[idx[k + 1]], vtx[idx[k + 2]], static_cast<std::uint32_t>(i),
                                    tris);
             for (const auto& t : tris) {
-                const std::uint64_t passed = detail::raster_rect(t, target.format(), c.state.depth_func,
-                                                                 c.state.depth_write, depth, target.width(), t.x0,
-                                                                 t.y0, t.x1, t.y1, options.allow_simd);
+                const std::uint64_t passed =
+                    detail::raster_rect(t, depth_state, depth, {t.x0, t.y0, t.x1, t.y1}, options.allow_simd);
                 if (active != kNoQuery) results[active] += passed;
             }
         }
@@ -226,7 +224,7 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
 
     // Back end: one task per tile; counters kept per tile as (query, count) runs.
     std::vector<std::vector<std::pair<std::uint32_t, std::uint64_t>>> tile_counts(tile_count);
-    std::uint32_t* depth = target.mutable_values().data();
+    const detail::DepthRows depth{target.mutable_values().data(), target.width()};
     const int width = target.width();
     const int height = target.height();
     const DepthFormat format = target.format();
@@ -238,16 +236,19 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
         const int ty = static_cast<int>(tile / static_cast<std::size_t>(tiles_x));
         const int x0 = tx * kTileSize, y0 = ty * kTileSize;
         const int x1 = std::min(x0 + kTileSize, width) - 1, y1 = std::min(y0 + kTileSize, height) - 1;
+        const auto clip_to_tile = [&](int bx0, int by0, int bx1, int by1) {
+            return detail::PixelRect{std::max(x0, bx0), std::max(y0, by0), std::min(x1, bx1), std::min(y1, by1)};
+        };
         auto& counts = tile_counts[tile];
         for (const Ref& r : bins[tile]) {
             const std::uint32_t cmd = draw_cmds[r.draw];
             const Command& c = cmds[cmd];
+            const detail::DepthState depth_state{format, c.state.depth_func, c.state.depth_write};
             std::uint64_t passed;
             if (c.state.mode == RasterMode::ExactBounds) {
                 const auto& tri = per_draw_bounds[r.draw][r.tri];
-                passed = detail::bounds_rect(tri, per_draw_pool[r.draw].data(), format, c.state.depth_func,
-                                             c.state.depth_write, depth, width, std::max(x0, tri.x0),
-                                             std::max(y0, tri.y0), std::min(x1, tri.x1), std::min(y1, tri.y1));
+                passed = detail::bounds_rect(tri, per_draw_pool[r.draw].data(), depth_state, depth,
+                                             clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1));
             } else {
                 // Any-samples query with the mask off: once this query has a passing sample (in this
                 // tile, or in any tile: the flag), further draws in it change nothing; the kernel
@@ -259,9 +260,8 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
                                  answered[aq].load(std::memory_order_relaxed)))
                     continue;
                 const auto& tri = per_draw[r.draw][r.tri];
-                passed = detail::raster_rect(tri, format, c.state.depth_func, c.state.depth_write, depth, width,
-                                             std::max(x0, tri.x0), std::max(y0, tri.y0), std::min(x1, tri.x1),
-                                             std::min(y1, tri.y1), options.allow_simd, any_only);
+                passed = detail::raster_rect(tri, depth_state, depth, clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1),
+                                             options.allow_simd, any_only);
                 if (any_only && passed != 0) answered[aq].store(true, std::memory_order_relaxed);
             }
             const std::uint32_t q = cmd_query[cmd];

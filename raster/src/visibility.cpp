@@ -211,8 +211,8 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
             const double mz = t.margin_z;
             double last_lo = std::numeric_limits<double>::quiet_NaN(), last_hi = last_lo;
             std::uint32_t zmin = 0, zmax = 0;  // quantized once per distinct depth
-            detail::bounds_pixels(t, s.pool[r.item].data(), std::max(x0, t.x0), std::max(y0, t.y0),
-                                  std::min(x1, t.x1), std::min(y1, t.y1), [&](int px, int py, double zlo, double zhi) {
+            const detail::PixelRect rect{std::max(x0, t.x0), std::max(y0, t.y0), std::min(x1, t.x1), std::min(y1, t.y1)};
+            detail::bounds_pixels(t, s.pool[r.item].data(), rect, [&](int px, int py, double zlo, double zhi) {
                                       const auto p = static_cast<std::uint32_t>((py - y0) * kTile + (px - x0));
                                       if (!(zlo == last_lo)) {
                                           last_lo = zlo;
