@@ -4,11 +4,12 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "exact_bounds.h"
-#include "parallel_for.h"
+#include "raster/detail/parallel.h"
 #include "pipeline.h"
 #include "raster/command_batch.h"
 #include "validate.h"
@@ -109,8 +110,11 @@ Result<QueryResults> execute_reference(DepthTarget& target, const CommandBatch& 
 }
 
 Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, const ExecuteOptions& options) {
+    if (options.threads < 0)
+        return Error{"execute: threads = " + std::to_string(options.threads) +
+                     " is out of range: it must be >= 0 (0 = all hardware threads)"};
     if (Status s = detail::validate(target, batch); !s) return s.error();
-    const int threads = std::max(1, options.threads);
+    const int threads = detail::effective_threads(options.threads);
     const auto& cmds = batch.commands();
 
     // Front end, per draw in parallel; each draw's triangles land in its own list so the order is
@@ -152,7 +156,7 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
             pieces.push_back({static_cast<std::uint32_t>(d), k, std::min(n, k + 3 * kFrontEndPiece)});
     }
     std::vector<std::vector<detail::SetupTri>> piece_out(pieces.size());
-    detail::run_parallel(threads, pieces.size(), [&](std::size_t j) {
+    detail::parallel_for(threads, pieces.size(), [&](std::size_t j) {
         const std::size_t d = pieces[j].draw;
         const Command& c = cmds[draw_cmds[d]];
         const detail::FrontEndParams p = params_for(target, c.state);
@@ -183,7 +187,7 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
     // Parallel binning over bands of tile rows: each band walks every triangle in command order and
     // fills only its own tiles, so every bin is the same list for any thread count.
     const int bands = threads > 1 ? std::min(threads, tiles_y) : 1;
-    detail::run_parallel(threads, static_cast<std::size_t>(bands), [&](std::size_t band) {
+    detail::parallel_for(threads, static_cast<std::size_t>(bands), [&](std::size_t band) {
         const int band_ty0 = static_cast<int>(static_cast<std::size_t>(tiles_y) * band / static_cast<std::size_t>(bands));
         const int band_ty1 =
             static_cast<int>(static_cast<std::size_t>(tiles_y) * (band + 1) / static_cast<std::size_t>(bands)) - 1;
@@ -231,7 +235,7 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
     const auto& query_kinds = batch.query_kinds();
     const std::unique_ptr<std::atomic<bool>[]> answered(new std::atomic<bool>[query_kinds.size() + 1]);
     for (std::size_t q = 0; q <= query_kinds.size(); ++q) answered[q].store(false, std::memory_order_relaxed);
-    detail::run_parallel(threads, tile_count, [&](std::size_t tile) {
+    detail::parallel_for(threads, tile_count, [&](std::size_t tile) {
         const int tx = static_cast<int>(tile % static_cast<std::size_t>(tiles_x));
         const int ty = static_cast<int>(tile / static_cast<std::size_t>(tiles_x));
         const int x0 = tx * kTileSize, y0 = ty * kTileSize;

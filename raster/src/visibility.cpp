@@ -8,7 +8,7 @@
 #include <string>
 
 #include "exact_bounds.h"
-#include "parallel_for.h"
+#include "raster/detail/parallel.h"
 #include "pipeline.h"
 #include "raster/depth_target.h"
 
@@ -108,12 +108,15 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
                      " is outside 1.." + std::to_string(kMaxTargetSize) + " per side"};
     if (format != DepthFormat::D16 && format != DepthFormat::D24 && format != DepthFormat::D32F)
         return Error{"visibility pass: invalid depth format"};
+    if (threads < 0)
+        return Error{"visibility pass: threads = " + std::to_string(threads) +
+                     " is out of range: it must be >= 0 (0 = all hardware threads)"};
     // Every index and vertex is checked in the front end below, next to its use; only when some
     // check fails does `validate` run, to return the first error in item and index order.
     bool counts_ok = true;
     for (const VisibilityItem& it : items) counts_ok = counts_ok && it.mesh.indices.size() % 3 == 0;
     if (!counts_ok) return validate(items);
-    threads = std::max(1, threads);
+    threads = detail::effective_threads(threads);
     State& s = *s_;
 
     // Front end per item (the recorded draws' own setup, so the same polygons).
@@ -128,7 +131,7 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
     params.viewport = Viewport{0, 0, width, height};
     params.cull_face = CullFace::None;
     params.front_face = FrontFace::CCW;
-    detail::run_parallel(threads, items.size(), [&](std::size_t i) {
+    detail::parallel_for(threads, items.size(), [&](std::size_t i) {
         auto& tris = s.tris[i];
         auto& pool = s.pool[i];
         tris.clear();
@@ -188,7 +191,7 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
 
     // Per tile: every fragment's zmin into the two minima, then every fragment's zmax against the
     // minimum over the other objects.
-    detail::run_parallel(threads, tile_count, [&](std::size_t tile) {
+    detail::parallel_for(threads, tile_count, [&](std::size_t tile) {
         auto& bin = s.bins[tile];
         auto& frags = s.frags[tile];
         auto& hits = s.hits[tile];
