@@ -38,7 +38,9 @@ struct DepthRows {
     }
 };
 
-// The inclusive pixel rectangle [x0, x1] x [y0, y1] (inside the target).
+// The inclusive pixel rectangle [x0, x1] x [y0, y1] (inside the target). Passed by value: a
+// reference would alias the depth stores (int and uint32_t may alias), and the kernels would then
+// reload its bounds after every store (the portable kernel was 3% slower on large triangles).
 struct PixelRect {
     int x0, y0, x1, y1;
 };

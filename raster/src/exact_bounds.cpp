@@ -254,7 +254,7 @@ namespace {
 // the per-pixel callback is then a few instructions, inlined into the traversal.
 template <DepthFunc F, bool D32F>
 std::uint64_t bounds_rect_impl(const BoundsTri& tri, const BoundsVertex* pool, DepthFormat format, bool write,
-                               DepthRows depth, const PixelRect& rect) {
+                               DepthRows depth, PixelRect rect) {
     std::uint64_t passed = 0;
     const double mz = tri.margin_z;
     const auto pass_at = [](std::uint32_t in, std::uint32_t st) __attribute__((always_inline)) {
@@ -311,7 +311,7 @@ std::uint64_t bounds_rect_impl(const BoundsTri& tri, const BoundsVertex* pool, D
 }  // namespace
 
 std::uint64_t bounds_rect(const BoundsTri& tri, const BoundsVertex* pool, const DepthState& state, DepthRows depth,
-                          const PixelRect& rect) {
+                          PixelRect rect) {
     // One traversal per depth function and format class (D32F compares floats, D16 and D24
     // unsigned integers); the format and the write stay run-time values inside it.
     return dispatch_depth(state, [&]<DepthFormat Fmt, DepthFunc F, bool Write>() -> std::uint64_t {

@@ -90,7 +90,7 @@ void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const
 // test state.func of zmin (write) or zmax (!write) against the stored value, and the write of zmin
 // when state.write. Returns the covered pixels that passed.
 std::uint64_t bounds_rect(const BoundsTri& tri, const BoundsVertex* pool, const DepthState& state, DepthRows depth,
-                          const PixelRect& rect);
+                          PixelRect rect);
 
 // Outward quantization of a window depth in [0, 1] to the stored encoding (exposed for tests):
 // down = the largest representable value <= z, up = the smallest >= z. Inline: with the plane path
@@ -265,7 +265,7 @@ namespace bounds_paths {
 
 // A box of one pixel (BoundsTri::single), whatever the kind.
 template <class F>
-inline void single(const BoundsTri& tri, const BoundsVertex* pool, const PixelRect& rect, F& f) {
+inline void single(const BoundsTri& tri, const BoundsVertex* pool, PixelRect rect, F& f) {
     // One row and one column: no clip is needed (every vertex lies inside the slab and the
     // column) and no edge crosses a side strictly, so the general path below would take exactly
     // the vertices' depths.
@@ -281,7 +281,7 @@ inline void single(const BoundsTri& tri, const BoundsVertex* pool, const PixelRe
 
 // BoundsTri::Kind::Plane.
 template <class F>
-inline void plane(const BoundsTri& tri, const BoundsVertex* pool, const PixelRect& rect, F& f) {
+inline void plane(const BoundsTri& tri, const BoundsVertex* pool, PixelRect rect, F& f) {
     // Separating axes (the idea of conservative rasterization on GPUs: Hasselgren, Akenine-Moller
     // and Ohlsson, GPU Gems 2 ch. 42): a convex triangle and a square are disjoint iff one of the
     // square's two axes or the triangle's three edge normals separates them. The pixel box
@@ -350,7 +350,7 @@ inline void plane(const BoundsTri& tri, const BoundsVertex* pool, const PixelRec
 
 // BoundsTri::Kind::Column and Row.
 template <class F>
-inline void slab(const BoundsTri& tri, const BoundsVertex* pool, const PixelRect& rect, F& f) {
+inline void slab(const BoundsTri& tri, const BoundsVertex* pool, PixelRect rect, F& f) {
     const double m = tri.margin_xy;
     // Column: every column of the box contains the polygon's X range in its grown interval
     // (or every vertex has the same X), so the polygon's part above pixel (px, py)'s grown
@@ -391,7 +391,7 @@ inline void slab(const BoundsTri& tri, const BoundsVertex* pool, const PixelRect
 // its edges' crossings of the column's sides. Constant-depth polygons take a shortcut that gives the
 // same values (see the comment there and docs/reliable-raster.md).
 template <class F>
-inline void general(const BoundsTri& tri, const BoundsVertex* pool, const PixelRect& rect, F& f) {
+inline void general(const BoundsTri& tri, const BoundsVertex* pool, PixelRect rect, F& f) {
     const double m = tri.margin_xy;
     BoundsP3 poly[kBoundsMaxVerts];
     double py_lo = 1e308, py_hi = -1e308;
@@ -475,7 +475,7 @@ inline void general(const BoundsTri& tri, const BoundsVertex* pool, const PixelR
 // The four per-pixel paths are the functions of bounds_paths (BoundsTri::Kind); each gives a pixel
 // the values the general path would (or, for the plane path, a proven superset).
 template <class F>
-inline void bounds_pixels(const BoundsTri& tri, const BoundsVertex* pool, const PixelRect& rect, F&& f) {
+inline void bounds_pixels(const BoundsTri& tri, const BoundsVertex* pool, PixelRect rect, F&& f) {
     if (tri.single) return bounds_paths::single(tri, pool, rect, f);
     switch (tri.kind) {
         case BoundsTri::Kind::Plane: return bounds_paths::plane(tri, pool, rect, f);

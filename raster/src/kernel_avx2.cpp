@@ -119,7 +119,7 @@ inline unsigned chunk8(const SetupTri& t, std::uint32_t* row, int px, __m256 fy,
 constexpr int kNarrow = 16;  // rectangles narrower than this take the per-chunk edge path when it fits
 
 template <DepthFormat Fmt, DepthFunc F, bool Write>
-std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, const PixelRect& rect, bool stop_at_first) {
+std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, bool stop_at_first) {
     const int rx0 = rect.x0, ry0 = rect.y0, rx1 = rect.x1, ry1 = rect.y1;
     const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     std::uint64_t passed = 0;
@@ -210,7 +210,7 @@ std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, const PixelRect& 
 }  // namespace
 #endif
 
-std::uint64_t raster_rect_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, const PixelRect& rect,
+std::uint64_t raster_rect_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
                                bool stop_at_first) {
 #if defined(RASTER_KERNEL_AVX2)
     return dispatch_depth(state, [&]<DepthFormat Fmt, DepthFunc F, bool Write>() {

@@ -11,7 +11,7 @@ namespace portable {
 }  // namespace portable
 
 std::uint64_t raster_rect_portable(const SetupTri& tri, const DepthState& state, DepthRows depth,
-                                   const PixelRect& rect, bool stop_at_first) {
+                                   PixelRect rect, bool stop_at_first) {
     return portable::raster_rect_kernel(tri, state, depth, rect, stop_at_first);
 }
 

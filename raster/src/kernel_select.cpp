@@ -14,7 +14,7 @@ bool simd_allowed_by_environment() {
     return ok;
 }
 
-std::uint64_t raster_rect(const SetupTri& tri, const DepthState& state, DepthRows depth, const PixelRect& rect,
+std::uint64_t raster_rect(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
                           bool allow_simd, bool stop_at_first) {
     if (allow_simd && kernel_avx2_available() && simd_allowed_by_environment())
         return raster_rect_avx2(tri, state, depth, rect, stop_at_first);

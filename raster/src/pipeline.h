@@ -57,11 +57,11 @@ void setup_triangle(const FrontEndParams& params, const Float4& a, const Float4&
 // CULLIDE_RASTER_NO_SIMD is not set to a non-empty value other than "0" (bit-identical results).
 // stop_at_first: the caller only needs to know whether any sample passes (an any-samples query
 // with the depth mask off): the kernel may return any count >= 1 as soon as one sample passed.
-std::uint64_t raster_rect(const SetupTri& tri, const DepthState& state, DepthRows depth, const PixelRect& rect,
+std::uint64_t raster_rect(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
                           bool allow_simd, bool stop_at_first = false);
 std::uint64_t raster_rect_portable(const SetupTri& tri, const DepthState& state, DepthRows depth,
-                                   const PixelRect& rect, bool stop_at_first);
-std::uint64_t raster_rect_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, const PixelRect& rect,
+                                   PixelRect rect, bool stop_at_first);
+std::uint64_t raster_rect_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
                                bool stop_at_first);
 // The two kernels with the flat argument list that the white-box test (tests/raster/simd_test.cpp)
 // calls them with.
