@@ -16,12 +16,12 @@ include(CMakePackageConfigHelpers)
 set(CULLIDE_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/cullide" CACHE STRING
     "Where the CMake package files are installed (relative to the prefix)")
 
-install(TARGETS cullide_raster cullide_spatialhash cullide_lib EXPORT cullideTargets
+install(TARGETS cullide_outcome cullide_raster cullide_spatialhash cullide_lib EXPORT cullideTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-foreach(module raster spatialhash cullide)
+foreach(module raster/outcome raster spatialhash cullide)
   install(DIRECTORY ${PROJECT_SOURCE_DIR}/${module}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
           FILES_MATCHING PATTERN "*.h")
 endforeach()

@@ -1,4 +1,5 @@
-// Deterministic chunked parallelism for the cullide module.
+// Deterministic chunked parallelism for the cullide module: thin forwards to raster's parallel-for
+// (raster/detail/parallel.h), so cullide and raster share one executor and one thread-count rule.
 //
 // The caller owns threading (house style, after Box2D): an operation takes a thread count, splits its
 // work into chunks whose boundaries depend only on the input (never on the thread count), runs them

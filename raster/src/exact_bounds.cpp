@@ -250,34 +250,11 @@ void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const
 
 namespace {
 
-template <DepthFunc F, class T>
-inline bool depth_pass(T incoming, T stored) {
-    switch (F) {
-        case DepthFunc::Never:
-            return false;
-        case DepthFunc::Less:
-            return incoming < stored;
-        case DepthFunc::Equal:
-            return incoming == stored;
-        case DepthFunc::LEqual:
-            return incoming <= stored;
-        case DepthFunc::Greater:
-            return incoming > stored;
-        case DepthFunc::NotEqual:
-            return incoming != stored;
-        case DepthFunc::GEqual:
-            return incoming >= stored;
-        case DepthFunc::Always:
-            return true;
-    }
-    return false;
-}
-
 // bounds_rect for one depth function and format class (D32F compares floats, D16/D24 integers):
 // the per-pixel callback is then a few instructions, inlined into the traversal.
 template <DepthFunc F, bool D32F>
 std::uint64_t bounds_rect_impl(const BoundsTri& tri, const BoundsVertex* pool, DepthFormat format, bool write,
-                               std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1) {
+                               DepthRows depth, PixelRect rect) {
     std::uint64_t passed = 0;
     const double mz = tri.margin_z;
     const auto pass_at = [](std::uint32_t in, std::uint32_t st) __attribute__((always_inline)) {
@@ -294,13 +271,12 @@ std::uint64_t bounds_rect_impl(const BoundsTri& tri, const BoundsVertex* pool, D
     if (flat_plane) {
         const BoundsPlane d = load_plane(tri, pool);
         const std::uint32_t in = write ? quantize_down(d.pzlo - mz, format) : quantize_up(d.pzhi + mz, format);
-        const int ys = std::max(ry0, tri.y0), ye = std::min(ry1, tri.y1);
-        const int xs = std::max(rx0, tri.x0), xe = std::min(rx1, tri.x1);
+        const int ys = std::max(rect.y0, tri.y0), ye = std::min(rect.y1, tri.y1);
+        const int xs = std::max(rect.x0, tri.x0), xe = std::min(rect.x1, tri.x1);
         for (int py = ys; py <= ye; ++py) {
             int lo = xs - tri.x0, hi = xe - tri.x0;
             plane_row_span(d, static_cast<double>(py - tri.y0), lo, hi);
-            std::uint32_t* row = depth + static_cast<std::size_t>(py) * static_cast<std::size_t>(stride) +
-                                 static_cast<std::size_t>(tri.x0);
+            std::uint32_t* row = depth.row(py) + static_cast<std::size_t>(tri.x0);
             std::uint64_t n = 0;
             if (write) {
                 for (int x = lo; x <= hi; ++x) {
@@ -317,14 +293,13 @@ std::uint64_t bounds_rect_impl(const BoundsTri& tri, const BoundsVertex* pool, D
     }
     double last = std::numeric_limits<double>::quiet_NaN();  // quantize once per distinct depth
     std::uint32_t incoming = 0;
-    bounds_pixels(tri, pool, rx0, ry0, rx1, ry1, [&](int px, int py, double zlo, double zhi) __attribute__((always_inline)) {
+    bounds_pixels(tri, pool, rect, [&](int px, int py, double zlo, double zhi) __attribute__((always_inline)) {
         const double z = write ? zlo : zhi;
         if (!(z == last)) {
             last = z;
             incoming = write ? quantize_down(zlo - mz, format) : quantize_up(zhi + mz, format);
         }
-        std::uint32_t& stored = depth[static_cast<std::size_t>(py) * static_cast<std::size_t>(stride) +
-                                      static_cast<std::size_t>(px)];
+        std::uint32_t& stored = depth.row(py)[px];
         if (pass_at(incoming, stored)) {
             ++passed;
             if (write) stored = incoming;
@@ -333,37 +308,19 @@ std::uint64_t bounds_rect_impl(const BoundsTri& tri, const BoundsVertex* pool, D
     return passed;
 }
 
-template <bool D32F>
-std::uint64_t bounds_rect_format(const BoundsTri& tri, const BoundsVertex* pool, DepthFormat format, DepthFunc func,
-                                 bool write, std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1) {
-    switch (func) {
-        case DepthFunc::Never:
-            return 0;  // nothing passes, nothing is written
-        case DepthFunc::Less:
-            return bounds_rect_impl<DepthFunc::Less, D32F>(tri, pool, format, write, depth, stride, rx0, ry0, rx1, ry1);
-        case DepthFunc::Equal:
-            return bounds_rect_impl<DepthFunc::Equal, D32F>(tri, pool, format, write, depth, stride, rx0, ry0, rx1, ry1);
-        case DepthFunc::LEqual:
-            return bounds_rect_impl<DepthFunc::LEqual, D32F>(tri, pool, format, write, depth, stride, rx0, ry0, rx1, ry1);
-        case DepthFunc::Greater:
-            return bounds_rect_impl<DepthFunc::Greater, D32F>(tri, pool, format, write, depth, stride, rx0, ry0, rx1, ry1);
-        case DepthFunc::NotEqual:
-            return bounds_rect_impl<DepthFunc::NotEqual, D32F>(tri, pool, format, write, depth, stride, rx0, ry0, rx1, ry1);
-        case DepthFunc::GEqual:
-            return bounds_rect_impl<DepthFunc::GEqual, D32F>(tri, pool, format, write, depth, stride, rx0, ry0, rx1, ry1);
-        case DepthFunc::Always:
-            return bounds_rect_impl<DepthFunc::Always, D32F>(tri, pool, format, write, depth, stride, rx0, ry0, rx1, ry1);
-    }
-    return 0;
-}
-
 }  // namespace
 
-std::uint64_t bounds_rect(const BoundsTri& tri, const BoundsVertex* pool, DepthFormat format, DepthFunc func,
-                          bool write, std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1) {
-    if (format == DepthFormat::D32F)
-        return bounds_rect_format<true>(tri, pool, format, func, write, depth, stride, rx0, ry0, rx1, ry1);
-    return bounds_rect_format<false>(tri, pool, format, func, write, depth, stride, rx0, ry0, rx1, ry1);
+std::uint64_t bounds_rect(const BoundsTri& tri, const BoundsVertex* pool, const DepthState& state, DepthRows depth,
+                          PixelRect rect) {
+    // One traversal per depth function and format class (D32F compares floats, D16 and D24
+    // unsigned integers); the format and the write stay run-time values inside it.
+    return dispatch_depth(state, [&]<DepthFormat Fmt, DepthFunc F, bool Write>() -> std::uint64_t {
+        if constexpr (F == DepthFunc::Never) {
+            return 0;  // nothing passes, nothing is written
+        } else {
+            return bounds_rect_impl<F, Fmt == DepthFormat::D32F>(tri, pool, state.format, Write, depth, rect);
+        }
+    });
 }
 
 }  // namespace raster::detail

@@ -86,11 +86,11 @@ inline BoundsPlane load_plane(const BoundsTri& t, const BoundsVertex* pool) {
 void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const Double4& b, const Double4& c,
                            std::uint32_t draw, std::vector<BoundsTri>& out, std::vector<BoundsVertex>& pool);
 
-// Rasterizes `tri` (polygon in `pool`) over [rx0, rx1] x [ry0, ry1] (inclusive, inside the target):
-// per covered pixel the depth test `func` of zmin (write) or zmax (!write) against the stored
-// value, and the write of zmin when `write`. Returns the covered pixels that passed.
-std::uint64_t bounds_rect(const BoundsTri& tri, const BoundsVertex* pool, DepthFormat format, DepthFunc func,
-                          bool write, std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1);
+// Rasterizes `tri` (polygon in `pool`) over `rect` (inside the target): per covered pixel the depth
+// test state.func of zmin (write) or zmax (!write) against the stored value, and the write of zmin
+// when state.write. Returns the covered pixels that passed.
+std::uint64_t bounds_rect(const BoundsTri& tri, const BoundsVertex* pool, const DepthState& state, DepthRows depth,
+                          PixelRect rect);
 
 // Outward quantization of a window depth in [0, 1] to the stored encoding (exposed for tests):
 // down = the largest representable value <= z, up = the smallest >= z. Inline: with the plane path
@@ -261,137 +261,138 @@ __attribute__((always_inline)) inline void slab_depth_range(const SlabEdge* e, i
     }
 }
 
-// Calls f(px, py, zlo, zhi) for every pixel of [rx0, rx1] x [ry0, ry1] whose square (grown by
-// tri.margin_xy) meets the polygon (the plane path may add pixels that a rounding-error bound
-// cannot rule out), with a range containing the polygon's depths over that part (before margin_z
-// and quantization): see docs/reliable-raster.md. Rows in increasing order, pixels of a row in
-// increasing order. The values do not depend on the rectangle: a pixel gets the same (zlo, zhi)
-// whichever rectangle (tile) contains it.
-//
-// General path, per row: the polygon is clipped to the row's slab (skipped when it already lies inside it: the
-// clip would return it unchanged); then the depth range over each pixel's column is the range
-// over the row polygon's boundary inside the column (a linear function's extremes over a convex
-// set lie on its boundary): its vertices inside the column and its edges' crossings of the
-// column's sides. Constant-depth polygons and one-pixel triangles take shortcuts that give the
-// same values (see the comments there and docs/reliable-raster.md).
+namespace bounds_paths {
+
+// A box of one pixel (BoundsTri::single), whatever the kind.
 template <class F>
-inline void bounds_pixels(const BoundsTri& tri, const BoundsVertex* pool, int rx0, int ry0, int rx1, int ry1,
-                          F&& f) {
-    if (tri.single) {
-        // One row and one column: no clip is needed (every vertex lies inside the slab and the
-        // column) and no edge crosses a side strictly, so the general path below would take exactly
-        // the vertices' depths.
-        if (tri.x0 < rx0 || tri.x0 > rx1 || tri.y0 < ry0 || tri.y0 > ry1) return;
-        double zlo = pool[tri.first].z, zhi = zlo;
-        for (int i = 1; i < tri.n; ++i) {
-            const double z = pool[tri.first + static_cast<std::uint32_t>(i)].z;
-            zlo = z < zlo ? z : zlo;
-            zhi = z > zhi ? z : zhi;
-        }
-        f(tri.x0, tri.y0, zlo, zhi);
-        return;
+inline void single(const BoundsTri& tri, const BoundsVertex* pool, PixelRect rect, F& f) {
+    // One row and one column: no clip is needed (every vertex lies inside the slab and the
+    // column) and no edge crosses a side strictly, so the general path below would take exactly
+    // the vertices' depths.
+    if (tri.x0 < rect.x0 || tri.x0 > rect.x1 || tri.y0 < rect.y0 || tri.y0 > rect.y1) return;
+    double zlo = pool[tri.first].z, zhi = zlo;
+    for (int i = 1; i < tri.n; ++i) {
+        const double z = pool[tri.first + static_cast<std::uint32_t>(i)].z;
+        zlo = z < zlo ? z : zlo;
+        zhi = z > zhi ? z : zhi;
     }
-    if (tri.kind == BoundsTri::Kind::Plane) {
-        // Separating axes (the idea of conservative rasterization on GPUs: Hasselgren, Akenine-Moller
-        // and Ohlsson, GPU Gems 2 ch. 42): a convex triangle and a square are disjoint iff one of the
-        // square's two axes or the triangle's three edge normals separates them. The pixel box
-        // already handles the square's axes; per edge, the grown square is dropped only when the
-        // edge function, at the square's corner that maximizes it, is below a threshold that covers
-        // every rounding (setup). Depth: the plane over the grown square, widened by its error
-        // bound and clamped to the vertex depth range. Closed form per pixel, nothing carried from
-        // pixel to pixel: a pixel gets the same values in any rectangle (tile).
-        //
-        // Tightening (not needed for correctness): the plane's range over the whole square is loose
-        // where the square sticks out of the triangle (most pixels of a sliver), so it is also
-        // clamped to the triangle's depth range over the pixel's row slab and, for boxes at most
-        // kTightColumns wide, over its column slab (each read off the boundary, slab_depth_range,
-        // widened by sw for its rounding). Each range is a function of py or px alone.
-        const BoundsPlane d = load_plane(tri, pool);
-        const int ys = std::max(ry0, tri.y0), ye = std::min(ry1, tri.y1);
-        const int xs = std::max(rx0, tri.x0), xe = std::min(rx1, tri.x1);
-        if (xs > xe || ys > ye) return;
-        const double m = tri.margin_xy;
-        const BoundsVertex* v = pool + tri.first;
-        const bool tight = d.pzlo != d.pzhi;  // constant depth: [z, z] already
-        const bool tight_cols = tight && tri.x1 - tri.x0 < kTightColumns;
-        double col_lo[kTightColumns], col_hi[kTightColumns];
-        SlabEdge ex[3], ey[3];
-        if (tight) slab_edges<true>(v, 3, ey);
-        if (tight_cols) {
-            slab_edges<false>(v, 3, ex);
+    f(tri.x0, tri.y0, zlo, zhi);
+}
+
+// BoundsTri::Kind::Plane.
+template <class F>
+inline void plane(const BoundsTri& tri, const BoundsVertex* pool, PixelRect rect, F& f) {
+    // Separating axes (the idea of conservative rasterization on GPUs: Hasselgren, Akenine-Moller
+    // and Ohlsson, GPU Gems 2 ch. 42): a convex triangle and a square are disjoint iff one of the
+    // square's two axes or the triangle's three edge normals separates them. The pixel box
+    // already handles the square's axes; per edge, the grown square is dropped only when the
+    // edge function, at the square's corner that maximizes it, is below a threshold that covers
+    // every rounding (setup). Depth: the plane over the grown square, widened by its error
+    // bound and clamped to the vertex depth range. Closed form per pixel, nothing carried from
+    // pixel to pixel: a pixel gets the same values in any rectangle (tile).
+    //
+    // Tightening (not needed for correctness): the plane's range over the whole square is loose
+    // where the square sticks out of the triangle (most pixels of a sliver), so it is also
+    // clamped to the triangle's depth range over the pixel's row slab and, for boxes at most
+    // kTightColumns wide, over its column slab (each read off the boundary, slab_depth_range,
+    // widened by sw for its rounding). Each range is a function of py or px alone.
+    const BoundsPlane d = load_plane(tri, pool);
+    const int ys = std::max(rect.y0, tri.y0), ye = std::min(rect.y1, tri.y1);
+    const int xs = std::max(rect.x0, tri.x0), xe = std::min(rect.x1, tri.x1);
+    if (xs > xe || ys > ye) return;
+    const double m = tri.margin_xy;
+    const BoundsVertex* v = pool + tri.first;
+    const bool tight = d.pzlo != d.pzhi;  // constant depth: [z, z] already
+    const bool tight_cols = tight && tri.x1 - tri.x0 < kTightColumns;
+    double col_lo[kTightColumns], col_hi[kTightColumns];
+    SlabEdge ex[3], ey[3];
+    if (tight) slab_edges<true>(v, 3, ey);
+    if (tight_cols) {
+        slab_edges<false>(v, 3, ex);
+        for (int px = xs; px <= xe; ++px) {
+            const double fx = static_cast<double>(px);
+            double a = 0, b = 0;
+            slab_depth_range(ex, 3, fx - m, fx + 1.0 + m, a, b);
+            col_lo[px - xs] = a - d.sw;
+            col_hi[px - xs] = b + d.sw;
+        }
+    }
+    for (int py = ys; py <= ye; ++py) {
+        const double ly = static_cast<double>(py - tri.y0);
+        const double rz = d.pz + d.pgy * ly;
+        int lo = xs - tri.x0, hi = xe - tri.x0;  // local pixel columns
+        plane_row_span(d, ly, lo, hi);
+        if (lo > hi) continue;
+        double rlo = d.pzlo, rhi = d.pzhi;
+        if (tight) {
+            const double fy = static_cast<double>(py);
+            double a = 0, b = 0;
+            slab_depth_range(ey, 3, fy - m, fy + 1.0 + m, a, b);
+            rlo = std::max(rlo, a - d.sw);
+            rhi = std::min(rhi, b + d.sw);
+        }
+        for (int px = tri.x0 + lo; px <= tri.x0 + hi; ++px) {
+            const double lx = static_cast<double>(px - tri.x0);
+            const double zc = rz + d.pgx * lx;
+            const double zl = zc - d.pw, zh = zc + d.pw;
+            double zlo = zl > rlo ? zl : rlo;
+            double zhi = zh < rhi ? zh : rhi;
+            if (tight_cols) {
+                zlo = std::max(zlo, col_lo[px - xs]);
+                zhi = std::min(zhi, col_hi[px - xs]);
+            }
+            // An empty interval proves that the square misses the triangle (a point of it
+            // would have its depth in every range): nothing to report.
+            if (zlo <= zhi) f(px, py, zlo, zhi);
+        }
+    }
+}
+
+// BoundsTri::Kind::Column and Row.
+template <class F>
+inline void slab(const BoundsTri& tri, const BoundsVertex* pool, PixelRect rect, F& f) {
+    const double m = tri.margin_xy;
+    // Column: every column of the box contains the polygon's X range in its grown interval
+    // (or every vertex has the same X), so the polygon's part above pixel (px, py)'s grown
+    // square is its part over the row slab [py - m, py + 1 + m], whatever px: its depth range
+    // is read off its boundary (slab_depth_range: the general path's column code with Y for X,
+    // without clipping) once per row and reported for the box's columns (one or two). Row: the
+    // same with X and Y exchanged.
+    const int ys = std::max(rect.y0, tri.y0), ye = std::min(rect.y1, tri.y1);
+    const int xs = std::max(rect.x0, tri.x0), xe = std::min(rect.x1, tri.x1);
+    if (xs > xe || ys > ye) return;
+    const BoundsVertex* v = pool + tri.first;
+    double zlo = 0, zhi = 0;
+    SlabEdge e[kBoundsMaxVerts];
+    if (tri.kind == BoundsTri::Kind::Column) {
+        slab_edges<true>(v, tri.n, e);
+        for (int py = ys; py <= ye; ++py) {
+            const double fy = static_cast<double>(py);
+            slab_depth_range(e, tri.n, fy - m, fy + 1.0 + m, zlo, zhi);
+            if (!(zlo <= zhi)) continue;
+            for (int px = xs; px <= xe; ++px) f(px, py, zlo, zhi);
+        }
+    } else {
+        slab_edges<false>(v, tri.n, e);
+        for (int py = ys; py <= ye; ++py) {  // one or two rows: recomputed per row, in order
             for (int px = xs; px <= xe; ++px) {
                 const double fx = static_cast<double>(px);
-                double a = 0, b = 0;
-                slab_depth_range(ex, 3, fx - m, fx + 1.0 + m, a, b);
-                col_lo[px - xs] = a - d.sw;
-                col_hi[px - xs] = b + d.sw;
-            }
-        }
-        for (int py = ys; py <= ye; ++py) {
-            const double ly = static_cast<double>(py - tri.y0);
-            const double rz = d.pz + d.pgy * ly;
-            int lo = xs - tri.x0, hi = xe - tri.x0;  // local pixel columns
-            plane_row_span(d, ly, lo, hi);
-            if (lo > hi) continue;
-            double rlo = d.pzlo, rhi = d.pzhi;
-            if (tight) {
-                const double fy = static_cast<double>(py);
-                double a = 0, b = 0;
-                slab_depth_range(ey, 3, fy - m, fy + 1.0 + m, a, b);
-                rlo = std::max(rlo, a - d.sw);
-                rhi = std::min(rhi, b + d.sw);
-            }
-            for (int px = tri.x0 + lo; px <= tri.x0 + hi; ++px) {
-                const double lx = static_cast<double>(px - tri.x0);
-                const double zc = rz + d.pgx * lx;
-                const double zl = zc - d.pw, zh = zc + d.pw;
-                double zlo = zl > rlo ? zl : rlo;
-                double zhi = zh < rhi ? zh : rhi;
-                if (tight_cols) {
-                    zlo = std::max(zlo, col_lo[px - xs]);
-                    zhi = std::min(zhi, col_hi[px - xs]);
-                }
-                // An empty interval proves that the square misses the triangle (a point of it
-                // would have its depth in every range): nothing to report.
+                slab_depth_range(e, tri.n, fx - m, fx + 1.0 + m, zlo, zhi);
                 if (zlo <= zhi) f(px, py, zlo, zhi);
             }
         }
-        return;
     }
+}
+
+// BoundsTri::Kind::General, per row: the polygon is clipped to the row's slab (skipped when it
+// already lies inside it: the clip would return it unchanged); then the depth range over each
+// pixel's column is the range over the row polygon's boundary inside the column (a linear
+// function's extremes over a convex set lie on its boundary): its vertices inside the column and
+// its edges' crossings of the column's sides. Constant-depth polygons take a shortcut that gives the
+// same values (see the comment there and docs/reliable-raster.md).
+template <class F>
+inline void general(const BoundsTri& tri, const BoundsVertex* pool, PixelRect rect, F& f) {
     const double m = tri.margin_xy;
-    if (tri.kind == BoundsTri::Kind::Column || tri.kind == BoundsTri::Kind::Row) {
-        // Column: every column of the box contains the polygon's X range in its grown interval
-        // (or every vertex has the same X), so the polygon's part above pixel (px, py)'s grown
-        // square is its part over the row slab [py - m, py + 1 + m], whatever px: its depth range
-        // is read off its boundary (slab_depth_range: the general path's column code with Y for X,
-        // without clipping) once per row and reported for the box's columns (one or two). Row: the
-        // same with X and Y exchanged.
-        const int ys = std::max(ry0, tri.y0), ye = std::min(ry1, tri.y1);
-        const int xs = std::max(rx0, tri.x0), xe = std::min(rx1, tri.x1);
-        if (xs > xe || ys > ye) return;
-        const BoundsVertex* v = pool + tri.first;
-        double zlo = 0, zhi = 0;
-        SlabEdge e[kBoundsMaxVerts];
-        if (tri.kind == BoundsTri::Kind::Column) {
-            slab_edges<true>(v, tri.n, e);
-            for (int py = ys; py <= ye; ++py) {
-                const double fy = static_cast<double>(py);
-                slab_depth_range(e, tri.n, fy - m, fy + 1.0 + m, zlo, zhi);
-                if (!(zlo <= zhi)) continue;
-                for (int px = xs; px <= xe; ++px) f(px, py, zlo, zhi);
-            }
-        } else {
-            slab_edges<false>(v, tri.n, e);
-            for (int py = ys; py <= ye; ++py) {  // one or two rows: recomputed per row, in order
-                for (int px = xs; px <= xe; ++px) {
-                    const double fx = static_cast<double>(px);
-                    slab_depth_range(e, tri.n, fx - m, fx + 1.0 + m, zlo, zhi);
-                    if (zlo <= zhi) f(px, py, zlo, zhi);
-                }
-            }
-        }
-        return;
-    }
     BoundsP3 poly[kBoundsMaxVerts];
     double py_lo = 1e308, py_hi = -1e308;
     for (int i = 0; i < tri.n; ++i) {
@@ -411,7 +412,7 @@ inline void bounds_pixels(const BoundsTri& tri, const BoundsVertex* pool, int rx
     BoundsP3 row_a[kBoundsMaxVerts];
     BoundsP3 row_b[kBoundsMaxVerts];
     constexpr double kInf = __builtin_inf();
-    for (int py = ry0; py <= ry1; ++py) {
+    for (int py = rect.y0; py <= rect.y1; ++py) {
         const double fy = static_cast<double>(py);
         // Y >= py - m, then Y <= py + 1 + m; a clip that keeps every vertex is the identity.
         const BoundsP3* rp = poly;
@@ -432,8 +433,8 @@ inline void bounds_pixels(const BoundsTri& tri, const BoundsVertex* pool, int rx
             hi = hi > rp[i].v[0] ? hi : rp[i].v[0];
         }
         const double xs_d = std::max(std::ceil(lo - m) - 1.0, -1.0);
-        const int xs = std::max(rx0, static_cast<int>(xs_d));
-        const int xe = std::min(rx1, static_cast<int>(std::min(std::floor(hi + m), static_cast<double>(rx1))));
+        const int xs = std::max(rect.x0, static_cast<int>(xs_d));
+        const int xe = std::min(rect.x1, static_cast<int>(std::min(std::floor(hi + m), static_cast<double>(rect.x1))));
         if (flat) {
             const double z = poly[0].v[2];
             for (int px = xs; px <= xe; ++px) {
@@ -459,6 +460,28 @@ inline void bounds_pixels(const BoundsTri& tri, const BoundsVertex* pool, int rx
             slab_depth_range(edges, rn, fx - m, fx + 1.0 + m, zlo, zhi);
             if (zlo <= zhi) f(px, py, zlo, zhi);
         }
+    }
+}
+
+}  // namespace bounds_paths
+
+// Calls f(px, py, zlo, zhi) for every pixel of `rect` whose square (grown by
+// tri.margin_xy) meets the polygon (the plane path may add pixels that a rounding-error bound
+// cannot rule out), with a range containing the polygon's depths over that part (before margin_z
+// and quantization): see docs/reliable-raster.md. Rows in increasing order, pixels of a row in
+// increasing order. The values do not depend on the rectangle: a pixel gets the same (zlo, zhi)
+// whichever rectangle (tile) contains it.
+//
+// The four per-pixel paths are the functions of bounds_paths (BoundsTri::Kind); each gives a pixel
+// the values the general path would (or, for the plane path, a proven superset).
+template <class F>
+inline void bounds_pixels(const BoundsTri& tri, const BoundsVertex* pool, PixelRect rect, F&& f) {
+    if (tri.single) return bounds_paths::single(tri, pool, rect, f);
+    switch (tri.kind) {
+        case BoundsTri::Kind::Plane: return bounds_paths::plane(tri, pool, rect, f);
+        case BoundsTri::Kind::Column:
+        case BoundsTri::Kind::Row: return bounds_paths::slab(tri, pool, rect, f);
+        case BoundsTri::Kind::General: return bounds_paths::general(tri, pool, rect, f);
     }
 }
 

@@ -4,11 +4,12 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "exact_bounds.h"
-#include "parallel_for.h"
+#include "raster/detail/parallel.h"
 #include "pipeline.h"
 #include "raster/command_batch.h"
 #include "validate.h"
@@ -66,7 +67,7 @@ Result<QueryResults> execute_reference(DepthTarget& target, const CommandBatch& 
     std::vector<detail::SetupTri> tris;
     std::vector<detail::BoundsTri> btris;
     std::vector<detail::BoundsVertex> bpool;
-    std::uint32_t* depth = target.mutable_values().data();
+    const detail::DepthRows depth{target.mutable_values().data(), target.width()};
     const auto& cmds = batch.commands();
     for (std::size_t i = 0; i < cmds.size(); ++i) {
         const Command& c = cmds[i];
@@ -79,15 +80,14 @@ Result<QueryResults> execute_reference(DepthTarget& target, const CommandBatch& 
             continue;
         }
         const detail::FrontEndParams p = params_for(target, c.state);
+        const detail::DepthState depth_state{target.format(), c.state.depth_func, c.state.depth_write};
         if (c.state.mode == RasterMode::ExactBounds) {
             btris.clear();
             bpool.clear();
             setup_bounds_draw(p, c, static_cast<std::uint32_t>(i), btris, bpool);
             for (const auto& t : btris) {
-                const std::uint64_t passed = detail::bounds_rect(t, bpool.data(), target.format(),
-                                                                 c.state.depth_func,
-                                                                 c.state.depth_write, depth, target.width(), t.x0,
-                                                                 t.y0, t.x1, t.y1);
+                const std::uint64_t passed =
+                    detail::bounds_rect(t, bpool.data(), depth_state, depth, {t.x0, t.y0, t.x1, t.y1});
                 if (active != kNoQuery) results[active] += passed;
             }
             continue;
@@ -99,9 +99,8 @@ Result<QueryResults> execute_reference(DepthTarget& target, const CommandBatch& 
             detail::setup_triangle(p, vtx[idx[k]], vtx[idx[k + 1]], vtx[idx[k + 2]], static_cast<std::uint32_t>(i),
                                    tris);
             for (const auto& t : tris) {
-                const std::uint64_t passed = detail::raster_rect(t, target.format(), c.state.depth_func,
-                                                                 c.state.depth_write, depth, target.width(), t.x0,
-                                                                 t.y0, t.x1, t.y1, options.allow_simd);
+                const std::uint64_t passed =
+                    detail::raster_rect(t, depth_state, depth, {t.x0, t.y0, t.x1, t.y1}, options.allow_simd);
                 if (active != kNoQuery) results[active] += passed;
             }
         }
@@ -110,41 +109,60 @@ Result<QueryResults> execute_reference(DepthTarget& target, const CommandBatch& 
     return results;
 }
 
-Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, const ExecuteOptions& options) {
-    if (Status s = detail::validate(target, batch); !s) return s.error();
-    const int threads = std::max(1, options.threads);
-    const auto& cmds = batch.commands();
+namespace {
 
-    // Front end, per draw in parallel; each draw's triangles land in its own list so the order is
-    // the command order whatever the schedule.
-    std::vector<std::uint32_t> draw_cmds;
-    std::vector<std::uint32_t> draw_query;  // active query of each draw command (by command index)
-    std::vector<std::uint32_t> cmd_query(cmds.size(), kNoQuery);
-    {
-        std::uint32_t active = kNoQuery;
-        for (std::size_t i = 0; i < cmds.size(); ++i) {
-            if (cmds[i].kind == Command::Kind::BeginQuery) active = cmds[i].query;
-            else if (cmds[i].kind == Command::Kind::EndQuery) active = kNoQuery;
-            else {
-                draw_cmds.push_back(static_cast<std::uint32_t>(i));
-                cmd_query[i] = active;
-            }
+// The tiled executor's phases, in order: draws(), front_end(), bin(), then shade() per tile.
+
+// The draw commands of a batch and the query active at each command.
+struct Draws {
+    std::vector<std::uint32_t> cmds;       // command index of each draw, in command order
+    std::vector<std::uint32_t> cmd_query;  // per command: the active query, or kNoQuery
+};
+
+Draws draws(const CommandBatch& batch) {
+    const auto& cmds = batch.commands();
+    Draws d;
+    d.cmd_query.assign(cmds.size(), kNoQuery);
+    std::uint32_t active = kNoQuery;
+    for (std::size_t i = 0; i < cmds.size(); ++i) {
+        if (cmds[i].kind == Command::Kind::BeginQuery) {
+            active = cmds[i].query;
+        } else if (cmds[i].kind == Command::Kind::EndQuery) {
+            active = kNoQuery;
+        } else {
+            d.cmds.push_back(static_cast<std::uint32_t>(i));
+            d.cmd_query[i] = active;
         }
     }
-    std::vector<std::vector<detail::SetupTri>> per_draw(draw_cmds.size());
-    std::vector<std::vector<detail::BoundsTri>> per_draw_bounds(draw_cmds.size());  // exact-bounds draws
-    std::vector<std::vector<detail::BoundsVertex>> per_draw_pool(draw_cmds.size());
-    // With several threads, a big GL-exact draw is split into pieces of kFrontEndPiece triangles;
-    // piece 0 fills the draw's list, the others their own lists, appended after in piece order
-    // (so the list is the same as one serial pass, whatever the thread count).
+    return d;
+}
+
+// The front end's output, one list per draw (a GL-exact draw fills `tris`, an exact-bounds draw
+// `bounds` and its vertex `pool`).
+struct SetupDraws {
+    std::vector<std::vector<detail::SetupTri>> tris;
+    std::vector<std::vector<detail::BoundsTri>> bounds;
+    std::vector<std::vector<detail::BoundsVertex>> pool;
+};
+
+// Front end, per draw in parallel; each draw's triangles land in its own list so the order is the
+// command order whatever the schedule. With several threads, a big GL-exact draw is split into
+// pieces of kFrontEndPiece triangles; piece 0 fills the draw's list, the others their own lists,
+// appended after in piece order (so the list is the same as one serial pass, whatever the count).
+SetupDraws front_end(const DepthTarget& target, const CommandBatch& batch, const Draws& draws, int threads) {
+    const auto& cmds = batch.commands();
+    const std::size_t n_draws = draws.cmds.size();
+    SetupDraws out{std::vector<std::vector<detail::SetupTri>>(n_draws),
+                   std::vector<std::vector<detail::BoundsTri>>(n_draws),
+                   std::vector<std::vector<detail::BoundsVertex>>(n_draws)};
     constexpr std::size_t kFrontEndPiece = 2048;
     struct Piece {
         std::uint32_t draw;
         std::size_t k0, k1;  // index range [k0, k1) of the draw's index list (whole triangles)
     };
     std::vector<Piece> pieces;
-    for (std::size_t d = 0; d < draw_cmds.size(); ++d) {
-        const Command& c = cmds[draw_cmds[d]];
+    for (std::size_t d = 0; d < n_draws; ++d) {
+        const Command& c = cmds[draws.cmds[d]];
         const std::size_t n = c.state.mode == RasterMode::ExactBounds ? 0 : c.mesh.indices.size() / 3 * 3;
         if (threads == 1 || n <= 3 * kFrontEndPiece) {
             pieces.push_back({static_cast<std::uint32_t>(d), 0, n});
@@ -154,54 +172,65 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
             pieces.push_back({static_cast<std::uint32_t>(d), k, std::min(n, k + 3 * kFrontEndPiece)});
     }
     std::vector<std::vector<detail::SetupTri>> piece_out(pieces.size());
-    detail::run_parallel(threads, pieces.size(), [&](std::size_t j) {
+    detail::parallel_for(threads, pieces.size(), [&](std::size_t j) {
         const std::size_t d = pieces[j].draw;
-        const Command& c = cmds[draw_cmds[d]];
+        const Command& c = cmds[draws.cmds[d]];
         const detail::FrontEndParams p = params_for(target, c.state);
         if (c.state.mode == RasterMode::ExactBounds) {
-            setup_bounds_draw(p, c, draw_cmds[d], per_draw_bounds[d], per_draw_pool[d]);
+            setup_bounds_draw(p, c, draws.cmds[d], out.bounds[d], out.pool[d]);
             return;
         }
         const auto& idx = c.mesh.indices;
         const auto& vtx = c.mesh.vertices;
-        auto& out = pieces[j].k0 == 0 ? per_draw[d] : piece_out[j];
-        out.reserve(out.size() + (pieces[j].k1 - pieces[j].k0) / 3);  // one SetupTri per unclipped triangle
+        auto& list = pieces[j].k0 == 0 ? out.tris[d] : piece_out[j];
+        list.reserve(list.size() + (pieces[j].k1 - pieces[j].k0) / 3);  // one SetupTri per unclipped triangle
         for (std::size_t k = pieces[j].k0; k + 2 < pieces[j].k1; k += 3)
-            detail::setup_triangle(p, vtx[idx[k]], vtx[idx[k + 1]], vtx[idx[k + 2]], draw_cmds[d], out);
+            detail::setup_triangle(p, vtx[idx[k]], vtx[idx[k + 1]], vtx[idx[k + 2]], draws.cmds[d], list);
     });
     for (std::size_t j = 0; j < pieces.size(); ++j)
         if (pieces[j].k0 != 0)
-            per_draw[pieces[j].draw].insert(per_draw[pieces[j].draw].end(), piece_out[j].begin(), piece_out[j].end());
+            out.tris[pieces[j].draw].insert(out.tris[pieces[j].draw].end(), piece_out[j].begin(), piece_out[j].end());
+    return out;
+}
 
-    // Binning: each tile lists the triangles overlapping it, in command order.
-    const int tiles_x = (target.width() + kTileSize - 1) / kTileSize;
-    const int tiles_y = (target.height() + kTileSize - 1) / kTileSize;
-    const std::size_t tile_count = static_cast<std::size_t>(tiles_x) * static_cast<std::size_t>(tiles_y);
-    struct Ref {
-        std::uint32_t draw;
-        std::uint32_t tri;
-    };
-    std::vector<std::vector<Ref>> bins(tile_count);
-    // Parallel binning over bands of tile rows: each band walks every triangle in command order and
-    // fills only its own tiles, so every bin is the same list for any thread count.
-    const int bands = threads > 1 ? std::min(threads, tiles_y) : 1;
-    detail::run_parallel(threads, static_cast<std::size_t>(bands), [&](std::size_t band) {
-        const int band_ty0 = static_cast<int>(static_cast<std::size_t>(tiles_y) * band / static_cast<std::size_t>(bands));
-        const int band_ty1 =
-            static_cast<int>(static_cast<std::size_t>(tiles_y) * (band + 1) / static_cast<std::size_t>(bands)) - 1;
-        auto bin = [&](std::size_t d, std::size_t t, int bx0, int by0, int bx1, int by1) {
-            for (int ty = std::max(by0 / kTileSize, band_ty0); ty <= std::min(by1 / kTileSize, band_ty1); ++ty)
-                for (int tx = bx0 / kTileSize; tx <= bx1 / kTileSize; ++tx)
-                    bins[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x) + static_cast<std::size_t>(tx)]
-                        .push_back({static_cast<std::uint32_t>(d), static_cast<std::uint32_t>(t)});
+// The target cut into kTileSize squares, row-major.
+struct Tiles {
+    int x, y;  // tiles per row and per column
+    [[nodiscard]] std::size_t count() const { return static_cast<std::size_t>(x) * static_cast<std::size_t>(y); }
+    [[nodiscard]] std::size_t index(int tx, int ty) const {
+        return static_cast<std::size_t>(ty) * static_cast<std::size_t>(x) + static_cast<std::size_t>(tx);
+    }
+};
+
+struct Ref {
+    std::uint32_t draw;
+    std::uint32_t tri;
+};
+
+// Binning: each tile lists the triangles overlapping it, in command order. In parallel over bands
+// of tile rows: each band walks every triangle in command order and fills only its own tiles, so
+// every bin is the same list for any thread count.
+std::vector<std::vector<Ref>> bin(const SetupDraws& setup, const Tiles& tiles, int threads) {
+    std::vector<std::vector<Ref>> bins(tiles.count());
+    const int bands = threads > 1 ? std::min(threads, tiles.y) : 1;
+    detail::parallel_for(threads, static_cast<std::size_t>(bands), [&](std::size_t band) {
+        const auto n_bands = static_cast<std::size_t>(bands);
+        const int band_ty0 = static_cast<int>(static_cast<std::size_t>(tiles.y) * band / n_bands);
+        const int band_ty1 = static_cast<int>(static_cast<std::size_t>(tiles.y) * (band + 1) / n_bands) - 1;
+        const auto add = [&](std::size_t d, std::size_t t, int tx, int ty) {
+            bins[tiles.index(tx, ty)].push_back({static_cast<std::uint32_t>(d), static_cast<std::uint32_t>(t)});
         };
-        for (std::size_t d = 0; d < per_draw.size(); ++d) {
-            for (std::size_t t = 0; t < per_draw[d].size(); ++t) {
-                const auto& tri = per_draw[d][t];
+        const auto bin_box = [&](std::size_t d, std::size_t t, int bx0, int by0, int bx1, int by1) {
+            for (int ty = std::max(by0 / kTileSize, band_ty0); ty <= std::min(by1 / kTileSize, band_ty1); ++ty)
+                for (int tx = bx0 / kTileSize; tx <= bx1 / kTileSize; ++tx) add(d, t, tx, ty);
+        };
+        for (std::size_t d = 0; d < setup.tris.size(); ++d) {
+            for (std::size_t t = 0; t < setup.tris[d].size(); ++t) {
+                const auto& tri = setup.tris[d][t];
                 const int ty0 = std::max(tri.y0 / kTileSize, band_ty0), ty1 = std::min(tri.y1 / kTileSize, band_ty1);
                 if (ty0 > ty1) continue;
                 if (tri.y0 / kTileSize == tri.y1 / kTileSize && tri.x0 / kTileSize == tri.x1 / kTileSize) {
-                    bin(d, t, tri.x0, tri.y0, tri.x1, tri.y1);
+                    bin_box(d, t, tri.x0, tri.y0, tri.x1, tri.y1);
                     continue;
                 }
                 // GL-exact triangles over several tiles: tile-level trivial reject (no centre of the
@@ -212,66 +241,99 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
                         const int rx1 = std::min(tri.x1, tx * kTileSize + kTileSize - 1);
                         const int ry0 = std::max(tri.y0, ty * kTileSize);
                         const int ry1 = std::min(tri.y1, ty * kTileSize + kTileSize - 1);
-                        if (detail::rect_outside(tri, rx0, ry0, rx1, ry1)) continue;
-                        bins[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x) + static_cast<std::size_t>(tx)]
-                            .push_back({static_cast<std::uint32_t>(d), static_cast<std::uint32_t>(t)});
+                        if (!detail::rect_outside(tri, rx0, ry0, rx1, ry1)) add(d, t, tx, ty);
                     }
             }
-            for (std::size_t t = 0; t < per_draw_bounds[d].size(); ++t) {
-                const auto& tri = per_draw_bounds[d][t];
-                bin(d, t, tri.x0, tri.y0, tri.x1, tri.y1);
+            for (std::size_t t = 0; t < setup.bounds[d].size(); ++t) {
+                const auto& tri = setup.bounds[d][t];
+                bin_box(d, t, tri.x0, tri.y0, tri.x1, tri.y1);
             }
         }
     });
+    return bins;
+}
 
-    // Back end: one task per tile; counters kept per tile as (query, count) runs.
-    std::vector<std::vector<std::pair<std::uint32_t, std::uint64_t>>> tile_counts(tile_count);
-    std::uint32_t* depth = target.mutable_values().data();
-    const int width = target.width();
-    const int height = target.height();
-    const DepthFormat format = target.format();
-    const auto& query_kinds = batch.query_kinds();
-    const std::unique_ptr<std::atomic<bool>[]> answered(new std::atomic<bool>[query_kinds.size() + 1]);
-    for (std::size_t q = 0; q <= query_kinds.size(); ++q) answered[q].store(false, std::memory_order_relaxed);
-    detail::run_parallel(threads, tile_count, [&](std::size_t tile) {
-        const int tx = static_cast<int>(tile % static_cast<std::size_t>(tiles_x));
-        const int ty = static_cast<int>(tile / static_cast<std::size_t>(tiles_x));
-        const int x0 = tx * kTileSize, y0 = ty * kTileSize;
-        const int x1 = std::min(x0 + kTileSize, width) - 1, y1 = std::min(y0 + kTileSize, height) - 1;
-        auto& counts = tile_counts[tile];
-        for (const Ref& r : bins[tile]) {
-            const std::uint32_t cmd = draw_cmds[r.draw];
-            const Command& c = cmds[cmd];
-            std::uint64_t passed;
-            if (c.state.mode == RasterMode::ExactBounds) {
-                const auto& tri = per_draw_bounds[r.draw][r.tri];
-                passed = detail::bounds_rect(tri, per_draw_pool[r.draw].data(), format, c.state.depth_func,
-                                             c.state.depth_write, depth, width, std::max(x0, tri.x0),
-                                             std::max(y0, tri.y0), std::min(x1, tri.x1), std::min(y1, tri.y1));
-            } else {
-                // Any-samples query with the mask off: once this query has a passing sample (in this
-                // tile, or in any tile: the flag), further draws in it change nothing; the kernel
-                // also stops at its first passing row. The boolean is the same whatever the schedule.
-                const std::uint32_t aq = cmd_query[cmd];
-                const bool any_only = aq != kNoQuery && !c.state.depth_write &&
-                                      query_kinds[aq] == QueryKind::AnySamplesPassed;
-                if (any_only && ((!counts.empty() && counts.back().first == aq) ||
-                                 answered[aq].load(std::memory_order_relaxed)))
-                    continue;
-                const auto& tri = per_draw[r.draw][r.tri];
-                passed = detail::raster_rect(tri, format, c.state.depth_func, c.state.depth_write, depth, width,
-                                             std::max(x0, tri.x0), std::max(y0, tri.y0), std::min(x1, tri.x1),
-                                             std::min(y1, tri.y1), options.allow_simd, any_only);
-                if (any_only && passed != 0) answered[aq].store(true, std::memory_order_relaxed);
-            }
-            const std::uint32_t q = cmd_query[cmd];
-            if (q == kNoQuery || passed == 0) continue;
-            if (!counts.empty() && counts.back().first == q) counts.back().second += passed;
-            else counts.emplace_back(q, passed);
+// What every tile's back end reads (shared, read-only but for the depth values of its own tile
+// and the any-samples flags).
+struct ShadeContext {
+    const CommandBatch& batch;
+    const Draws& draws;
+    const SetupDraws& setup;
+    detail::DepthRows depth;
+    int width, height;
+    DepthFormat format;
+    bool allow_simd;
+    std::atomic<bool>* answered;  // per query: an any-samples query already has a passing sample
+};
+
+// Back end of one tile: its bin in command order; counters kept as (query, count) runs.
+void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
+           std::vector<std::pair<std::uint32_t, std::uint64_t>>& counts) {
+    const int x0 = tx * kTileSize, y0 = ty * kTileSize;
+    const int x1 = std::min(x0 + kTileSize, ctx.width) - 1, y1 = std::min(y0 + kTileSize, ctx.height) - 1;
+    const auto clip_to_tile = [&](int bx0, int by0, int bx1, int by1) {
+        return detail::PixelRect{std::max(x0, bx0), std::max(y0, by0), std::min(x1, bx1), std::min(y1, by1)};
+    };
+    const auto& cmds = ctx.batch.commands();
+    const auto& query_kinds = ctx.batch.query_kinds();
+    for (const Ref& r : bin) {
+        const std::uint32_t cmd = ctx.draws.cmds[r.draw];
+        const Command& c = cmds[cmd];
+        const detail::DepthState depth_state{ctx.format, c.state.depth_func, c.state.depth_write};
+        const std::uint32_t q = ctx.draws.cmd_query[cmd];
+        std::uint64_t passed;
+        if (c.state.mode == RasterMode::ExactBounds) {
+            const auto& tri = ctx.setup.bounds[r.draw][r.tri];
+            passed = detail::bounds_rect(tri, ctx.setup.pool[r.draw].data(), depth_state, ctx.depth,
+                                         clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1));
+        } else {
+            // Any-samples query with the mask off: once this query has a passing sample (in this
+            // tile, or in any tile: the flag), further draws in it change nothing; the kernel also
+            // stops at its first passing row. The boolean is the same whatever the schedule.
+            const bool any_only = q != kNoQuery && !c.state.depth_write && query_kinds[q] == QueryKind::AnySamplesPassed;
+            if (any_only && ((!counts.empty() && counts.back().first == q) ||
+                             ctx.answered[q].load(std::memory_order_relaxed)))
+                continue;
+            const auto& tri = ctx.setup.tris[r.draw][r.tri];
+            passed = detail::raster_rect(tri, depth_state, ctx.depth, clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1),
+                                         ctx.allow_simd, any_only);
+            if (any_only && passed != 0) ctx.answered[q].store(true, std::memory_order_relaxed);
         }
+        if (q == kNoQuery || passed == 0) continue;
+        if (!counts.empty() && counts.back().first == q) counts.back().second += passed;
+        else counts.emplace_back(q, passed);
+    }
+}
+
+}  // namespace
+
+Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, const ExecuteOptions& options) {
+    if (options.threads < 0)
+        return Error{"execute: threads = " + std::to_string(options.threads) +
+                     " is out of range: it must be >= 0 (0 = all hardware threads)"};
+    if (Status s = detail::validate(target, batch); !s) return s.error();
+    const int threads = detail::effective_threads(options.threads);
+    const Draws draw_list = draws(batch);
+    const SetupDraws setup = front_end(target, batch, draw_list, threads);
+    const Tiles tiles{(target.width() + kTileSize - 1) / kTileSize, (target.height() + kTileSize - 1) / kTileSize};
+    const std::vector<std::vector<Ref>> bins = bin(setup, tiles, threads);
+
+    // Back end: one task per tile.
+    const std::size_t n_queries = batch.query_kinds().size();
+    const std::unique_ptr<std::atomic<bool>[]> answered(new std::atomic<bool>[n_queries + 1]);
+    for (std::size_t q = 0; q <= n_queries; ++q) answered[q].store(false, std::memory_order_relaxed);
+    const ShadeContext ctx{batch,          draw_list,       setup,
+                           {target.mutable_values().data(), target.width()},
+                           target.width(), target.height(), target.format(),
+                           options.allow_simd, answered.get()};
+    std::vector<std::vector<std::pair<std::uint32_t, std::uint64_t>>> tile_counts(tiles.count());
+    detail::parallel_for(threads, tiles.count(), [&](std::size_t tile) {
+        const int tx = static_cast<int>(tile % static_cast<std::size_t>(tiles.x));
+        const int ty = static_cast<int>(tile / static_cast<std::size_t>(tiles.x));
+        shade(ctx, tx, ty, bins[tile], tile_counts[tile]);
     });
 
-    QueryResults results(batch.query_kinds().size(), 0);
+    QueryResults results(n_queries, 0);
     for (const auto& counts : tile_counts)
         for (const auto& [q, n] : counts) results[q] += n;
     finish_results(batch, results);

@@ -119,8 +119,8 @@ inline unsigned chunk8(const SetupTri& t, std::uint32_t* row, int px, __m256 fy,
 constexpr int kNarrow = 16;  // rectangles narrower than this take the per-chunk edge path when it fits
 
 template <DepthFormat Fmt, DepthFunc F, bool Write>
-std::uint64_t raster_rect8(const SetupTri& t, std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1,
-                           bool stop_at_first) {
+std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, bool stop_at_first) {
+    const int rx0 = rect.x0, ry0 = rect.y0, rx1 = rect.x1, ry1 = rect.y1;
     const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     std::uint64_t passed = 0;
     if (rx1 - rx0 < kNarrow) {
@@ -146,7 +146,7 @@ std::uint64_t raster_rect8(const SetupTri& t, std::uint32_t* depth, int stride, 
                 lane_sx[i] = _mm256_mullo_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(sx[i])), iota);
             const __m256i zero_i = _mm256_setzero_si256();
             for (int py = ry0; py <= ry1; ++py) {
-                std::uint32_t* row = depth + static_cast<std::size_t>(py) * static_cast<std::size_t>(stride);
+                std::uint32_t* row = depth.row(py);
                 const __m256 fy = _mm256_set1_ps(static_cast<float>(py));
                 std::int32_t e_chunk[3];
                 #pragma GCC unroll 3
@@ -192,7 +192,7 @@ std::uint64_t raster_rect8(const SetupTri& t, std::uint32_t* depth, int stride, 
             avx2::edge_span(t.c[i] + t.dcdy[i] * 256 * py, t.dcdx[i], lo, hi);
         }
         if (lo > hi) continue;
-        std::uint32_t* row = depth + static_cast<std::size_t>(py) * static_cast<std::size_t>(stride);
+        std::uint32_t* row = depth.row(py);
         const __m256 fy = _mm256_set1_ps(static_cast<float>(py));
         const int ihi = static_cast<int>(hi);
         int px = static_cast<int>(lo);
@@ -207,42 +207,17 @@ std::uint64_t raster_rect8(const SetupTri& t, std::uint32_t* depth, int stride, 
     return passed;
 }
 
-template <DepthFormat Fmt, DepthFunc F>
-std::uint64_t by_write(bool w, const SetupTri& t, std::uint32_t* d, int s, int a, int b, int c, int e, bool stop) {
-    return w ? raster_rect8<Fmt, F, true>(t, d, s, a, b, c, e, stop) : raster_rect8<Fmt, F, false>(t, d, s, a, b, c, e, stop);
-}
-
-template <DepthFormat Fmt>
-std::uint64_t by_func(DepthFunc f, bool w, const SetupTri& t, std::uint32_t* d, int s, int a, int b, int c, int e,
-                      bool stop) {
-    switch (f) {
-        case DepthFunc::Never: return by_write<Fmt, DepthFunc::Never>(w, t, d, s, a, b, c, e, stop);
-        case DepthFunc::Less: return by_write<Fmt, DepthFunc::Less>(w, t, d, s, a, b, c, e, stop);
-        case DepthFunc::Equal: return by_write<Fmt, DepthFunc::Equal>(w, t, d, s, a, b, c, e, stop);
-        case DepthFunc::LEqual: return by_write<Fmt, DepthFunc::LEqual>(w, t, d, s, a, b, c, e, stop);
-        case DepthFunc::Greater: return by_write<Fmt, DepthFunc::Greater>(w, t, d, s, a, b, c, e, stop);
-        case DepthFunc::NotEqual: return by_write<Fmt, DepthFunc::NotEqual>(w, t, d, s, a, b, c, e, stop);
-        case DepthFunc::GEqual: return by_write<Fmt, DepthFunc::GEqual>(w, t, d, s, a, b, c, e, stop);
-        case DepthFunc::Always: return by_write<Fmt, DepthFunc::Always>(w, t, d, s, a, b, c, e, stop);
-    }
-    return 0;
-}
-
 }  // namespace
 #endif
 
-std::uint64_t raster_rect_avx2(const SetupTri& tri, DepthFormat format, DepthFunc func, bool write,
-                               std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1,
+std::uint64_t raster_rect_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
                                bool stop_at_first) {
 #if defined(RASTER_KERNEL_AVX2)
-    switch (format) {
-        case DepthFormat::D16: return by_func<DepthFormat::D16>(func, write, tri, depth, stride, rx0, ry0, rx1, ry1, stop_at_first);
-        case DepthFormat::D24: return by_func<DepthFormat::D24>(func, write, tri, depth, stride, rx0, ry0, rx1, ry1, stop_at_first);
-        case DepthFormat::D32F: return by_func<DepthFormat::D32F>(func, write, tri, depth, stride, rx0, ry0, rx1, ry1, stop_at_first);
-    }
-    return 0;
+    return dispatch_depth(state, [&]<DepthFormat Fmt, DepthFunc F, bool Write>() {
+        return raster_rect8<Fmt, F, Write>(tri, depth, rect, stop_at_first);
+    });
 #else
-    return avx2::raster_rect_kernel(tri, format, func, write, depth, stride, rx0, ry0, rx1, ry1, stop_at_first);
+    return avx2::raster_rect_kernel(tri, state, depth, rect, stop_at_first);
 #endif
 }
 

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "depth_dispatch.h"
 #include "raster/types.h"
 
 namespace raster::detail {
@@ -50,21 +51,30 @@ struct FrontEndParams {
 void setup_triangle(const FrontEndParams& params, const Float4& a, const Float4& b, const Float4& c,
                     std::uint32_t draw, std::vector<SetupTri>& out);
 
-// Rasterizes `tri` over the rectangle [rx0, rx1] x [ry0, ry1] (inclusive, inside the target and the
-// triangle's box) into `depth` (row-major, `stride` values per row). Returns the samples that passed.
+// Rasterizes `tri` over `rect` (inside the target and the triangle's box) into `depth` with the
+// draw's depth `state`. Returns the samples that passed.
 // allow_simd picks the 8-wide AVX2+FMA kernel when the CPU has it and the environment variable
 // CULLIDE_RASTER_NO_SIMD is not set to a non-empty value other than "0" (bit-identical results).
 // stop_at_first: the caller only needs to know whether any sample passes (an any-samples query
 // with the depth mask off): the kernel may return any count >= 1 as soon as one sample passed.
-std::uint64_t raster_rect(const SetupTri& tri, DepthFormat format, DepthFunc func, bool write,
-                          std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1, bool allow_simd,
-                          bool stop_at_first = false);
-std::uint64_t raster_rect_portable(const SetupTri& tri, DepthFormat format, DepthFunc func, bool write,
-                                   std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1,
-                                   bool stop_at_first);
-std::uint64_t raster_rect_avx2(const SetupTri& tri, DepthFormat format, DepthFunc func, bool write,
-                               std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1,
+std::uint64_t raster_rect(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
+                          bool allow_simd, bool stop_at_first = false);
+std::uint64_t raster_rect_portable(const SetupTri& tri, const DepthState& state, DepthRows depth,
+                                   PixelRect rect, bool stop_at_first);
+std::uint64_t raster_rect_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
                                bool stop_at_first);
+// The two kernels with the flat argument list that the white-box test (tests/raster/simd_test.cpp)
+// calls them with.
+inline std::uint64_t raster_rect_portable(const SetupTri& tri, DepthFormat format, DepthFunc func, bool write,
+                                          std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1,
+                                          bool stop_at_first) {
+    return raster_rect_portable(tri, {format, func, write}, {depth, stride}, {rx0, ry0, rx1, ry1}, stop_at_first);
+}
+inline std::uint64_t raster_rect_avx2(const SetupTri& tri, DepthFormat format, DepthFunc func, bool write,
+                                      std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1,
+                                      bool stop_at_first) {
+    return raster_rect_avx2(tri, {format, func, write}, {depth, stride}, {rx0, ry0, rx1, ry1}, stop_at_first);
+}
 // True when the CPU has AVX2 and FMA and this build has the AVX2 kernel (x86-64 GCC/Clang).
 bool kernel_avx2_available();
 // False when CULLIDE_RASTER_NO_SIMD forces the portable kernel everywhere (read once).

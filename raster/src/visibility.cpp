@@ -8,7 +8,7 @@
 #include <string>
 
 #include "exact_bounds.h"
-#include "parallel_for.h"
+#include "raster/detail/parallel.h"
 #include "pipeline.h"
 #include "raster/depth_target.h"
 
@@ -86,8 +86,16 @@ Error validate(std::span<const VisibilityItem> items) {
     return Error{"visibility pass: invalid input"};  // not reached: some check above fails
 }
 
+// The target cut into square tiles of `side` pixels, row-major.
+struct TileGrid {
+    int side, x, y;  // tile side, tiles per row and per column
+    [[nodiscard]] std::size_t count() const { return static_cast<std::size_t>(x) * static_cast<std::size_t>(y); }
+    [[nodiscard]] std::size_t pixels() const { return static_cast<std::size_t>(side) * static_cast<std::size_t>(side); }
+};
+
 }  // namespace
 
+// run()'s phases, in order: front_end, bin, then shade per tile; buffers kept between calls.
 struct VisibilityPass::State {
     std::vector<std::vector<detail::BoundsTri>> tris;     // per item
     std::vector<std::vector<detail::BoundsVertex>> pool;  // per item
@@ -96,7 +104,150 @@ struct VisibilityPass::State {
     std::vector<std::vector<Fragment>> frags;             // per tile (scratch)
     std::vector<std::vector<std::uint32_t>> hits;         // per tile: items found not fully visible
     std::vector<std::uint32_t> min1, obj1, min2;          // per pixel, tile-major (one tile = side^2)
+
+    // Front end per item (the recorded draws' own setup, so the same polygons). False when some
+    // item failed an input check (bad[i]).
+    bool front_end(int width, int height, std::span<const VisibilityItem> items, int threads);
+    // Binning, in item order; with one tile nothing is built (every triangle is in it).
+    void bin(std::span<const VisibilityItem> items, const TileGrid& grid);
+    // Per tile: every fragment's zmin into the two minima, then every fragment's zmax against the
+    // minimum over the other objects; the items found not fully visible go to hits[tile].
+    void shade(std::span<const VisibilityItem> items, const TileGrid& grid, int width, int height,
+               DepthFormat format, std::size_t tile);
 };
+
+bool VisibilityPass::State::front_end(int width, int height, std::span<const VisibilityItem> items, int threads) {
+    if (tris.size() < items.size()) {
+        tris.resize(items.size());
+        pool.resize(items.size());
+        bad.resize(items.size());
+    }
+    detail::FrontEndParams params{};
+    params.target_width = width;
+    params.target_height = height;
+    params.viewport = Viewport{0, 0, width, height};
+    params.cull_face = CullFace::None;
+    params.front_face = FrontFace::CCW;
+    detail::parallel_for(threads, items.size(), [&](std::size_t i) {
+        auto& item_tris = tris[i];
+        auto& item_pool = pool[i];
+        item_tris.clear();
+        item_pool.clear();
+        const MeshViewD& m = items[i].mesh;
+        item_tris.reserve(m.indices.size() / 3);
+        item_pool.reserve(m.indices.size());
+        bad[i] = 0;
+        const std::size_t nv = m.vertices.size();
+        for (std::size_t k = 0; k + 2 < m.indices.size(); k += 3) {
+            const std::uint32_t ia = m.indices[k], ib = m.indices[k + 1], ic = m.indices[k + 2];
+            if (ia >= nv || ib >= nv || ic >= nv) {
+                bad[i] = 1;
+                return;
+            }
+            const Double4 &a = m.vertices[ia], &b = m.vertices[ib], &c = m.vertices[ic];
+            if (!(valid_vertex(a) && valid_vertex(b) && valid_vertex(c))) {
+                bad[i] = 1;
+                return;
+            }
+            detail::setup_bounds_triangle(params, a, b, c, static_cast<std::uint32_t>(i), item_tris, item_pool);
+        }
+    });
+    for (std::size_t i = 0; i < items.size(); ++i)
+        if (bad[i]) return false;
+    return true;
+}
+
+void VisibilityPass::State::bin(std::span<const VisibilityItem> items, const TileGrid& grid) {
+    const std::size_t tile_count = grid.count();
+    if (bins.size() < tile_count) {
+        bins.resize(tile_count);
+        frags.resize(tile_count);
+        hits.resize(tile_count);
+    }
+    for (std::size_t t = 0; t < tile_count; ++t) bins[t].clear();
+    if (tile_count == 1) return;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        for (std::size_t k = 0; k < tris[i].size(); ++k) {
+            const detail::BoundsTri& t = tris[i][k];
+            for (int ty = t.y0 / grid.side; ty <= t.y1 / grid.side; ++ty)
+                for (int tx = t.x0 / grid.side; tx <= t.x1 / grid.side; ++tx)
+                    bins[static_cast<std::size_t>(ty) * static_cast<std::size_t>(grid.x) + static_cast<std::size_t>(tx)]
+                        .push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)});
+        }
+    }
+}
+
+void VisibilityPass::State::shade(std::span<const VisibilityItem> items, const TileGrid& grid, int width,
+                                  int height, DepthFormat format, std::size_t tile) {
+    const bool one_tile = grid.count() == 1;  // then every triangle is in it: no bin was built
+    auto& tile_bin = bins[tile];
+    auto& tile_frags = frags[tile];
+    auto& tile_hits = hits[tile];
+    tile_frags.clear();
+    tile_hits.clear();
+    if (tile_bin.empty() && !one_tile) return;
+    const int side = grid.side;
+    const int tx = static_cast<int>(tile % static_cast<std::size_t>(grid.x));
+    const int ty = static_cast<int>(tile / static_cast<std::size_t>(grid.x));
+    const int x0 = tx * side, y0 = ty * side;
+    const int x1 = std::min(x0 + side, width) - 1, y1 = std::min(y0 + side, height) - 1;
+    const std::size_t tile_pixels = grid.pixels();
+    const std::uint32_t clear = DepthTarget::encode_clear(1.0, format);
+    std::uint32_t* tile_min1 = min1.data() + tile * tile_pixels;
+    std::uint32_t* tile_obj1 = obj1.data() + tile * tile_pixels;
+    std::uint32_t* tile_min2 = min2.data() + tile * tile_pixels;
+    std::fill(tile_min1, tile_min1 + tile_pixels, clear);
+    std::fill(tile_obj1, tile_obj1 + tile_pixels, kNoObject);
+    std::fill(tile_min2, tile_min2 + tile_pixels, clear);
+    const auto draw = [&](const Ref r) __attribute__((always_inline)) {
+        const detail::BoundsTri& t = tris[r.item][r.tri];
+        const std::uint32_t obj = items[r.item].object;
+        const double mz = t.margin_z;
+        double last_lo = std::numeric_limits<double>::quiet_NaN(), last_hi = last_lo;
+        std::uint32_t zmin = 0, zmax = 0;  // quantized once per distinct depth
+        const detail::PixelRect rect{std::max(x0, t.x0), std::max(y0, t.y0), std::min(x1, t.x1), std::min(y1, t.y1)};
+        detail::bounds_pixels(t, pool[r.item].data(), rect, [&](int px, int py, double zlo, double zhi) {
+            const auto p = static_cast<std::uint32_t>((py - y0) * side + (px - x0));
+            if (!(zlo == last_lo)) {
+                last_lo = zlo;
+                zmin = detail::quantize_down(zlo - mz, format);
+            }
+            if (!(zhi == last_hi)) {
+                last_hi = zhi;
+                zmax = detail::quantize_up(zhi + mz, format);
+            }
+            if (obj == tile_obj1[p]) {
+                tile_min1[p] = std::min(tile_min1[p], zmin);
+            } else if (zmin < tile_min1[p]) {
+                tile_min2[p] = tile_min1[p];
+                tile_min1[p] = zmin;
+                tile_obj1[p] = obj;
+            } else {
+                tile_min2[p] = std::min(tile_min2[p], zmin);
+            }
+            tile_frags.push_back({r.item, p, zmax});
+        });
+    };
+    if (one_tile) {
+        for (std::size_t i = 0; i < items.size(); ++i)
+            for (std::size_t k = 0; k < tris[i].size(); ++k)
+                draw({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)});
+    } else {
+        for (const Ref& r : tile_bin) draw(r);
+    }
+    // min1 is the minimum over all objects (with the clear value) and min2 the minimum over the
+    // objects other than obj1's, so the minimum over the objects other than o is min2 when o is
+    // obj1 and min1 otherwise (ties between objects: then min2 == min1).
+    std::uint32_t last = kNoObject;
+    for (const Fragment& f : tile_frags) {
+        if (f.item == last) continue;
+        const std::uint32_t other = items[f.item].object == tile_obj1[f.pixel] ? tile_min2[f.pixel] : tile_min1[f.pixel];
+        if (f.zmax >= other) {  // the GEQUAL query passes here
+            tile_hits.push_back(f.item);
+            last = f.item;
+        }
+    }
+}
 
 VisibilityPass::VisibilityPass() : s_(std::make_unique<State>()) {}
 VisibilityPass::~VisibilityPass() = default;
@@ -108,155 +259,33 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
                      " is outside 1.." + std::to_string(kMaxTargetSize) + " per side"};
     if (format != DepthFormat::D16 && format != DepthFormat::D24 && format != DepthFormat::D32F)
         return Error{"visibility pass: invalid depth format"};
-    // Every index and vertex is checked in the front end below, next to its use; only when some
-    // check fails does `validate` run, to return the first error in item and index order.
+    if (threads < 0)
+        return Error{"visibility pass: threads = " + std::to_string(threads) +
+                     " is out of range: it must be >= 0 (0 = all hardware threads)"};
+    // Every index and vertex is checked in the front end, next to its use; only when some check
+    // fails does `validate` run, to return the first error in item and index order.
     bool counts_ok = true;
     for (const VisibilityItem& it : items) counts_ok = counts_ok && it.mesh.indices.size() % 3 == 0;
     if (!counts_ok) return validate(items);
-    threads = std::max(1, threads);
+    threads = detail::effective_threads(threads);
     State& s = *s_;
-
-    // Front end per item (the recorded draws' own setup, so the same polygons).
-    if (s.tris.size() < items.size()) {
-        s.tris.resize(items.size());
-        s.pool.resize(items.size());
-        s.bad.resize(items.size());
-    }
-    detail::FrontEndParams params{};
-    params.target_width = width;
-    params.target_height = height;
-    params.viewport = Viewport{0, 0, width, height};
-    params.cull_face = CullFace::None;
-    params.front_face = FrontFace::CCW;
-    detail::run_parallel(threads, items.size(), [&](std::size_t i) {
-        auto& tris = s.tris[i];
-        auto& pool = s.pool[i];
-        tris.clear();
-        pool.clear();
-        const MeshViewD& m = items[i].mesh;
-        tris.reserve(m.indices.size() / 3);
-        pool.reserve(m.indices.size());
-        s.bad[i] = 0;
-        const std::size_t nv = m.vertices.size();
-        for (std::size_t k = 0; k + 2 < m.indices.size(); k += 3) {
-            const std::uint32_t ia = m.indices[k], ib = m.indices[k + 1], ic = m.indices[k + 2];
-            if (ia >= nv || ib >= nv || ic >= nv) {
-                s.bad[i] = 1;
-                return;
-            }
-            const Double4 &a = m.vertices[ia], &b = m.vertices[ib], &c = m.vertices[ic];
-            if (!(valid_vertex(a) && valid_vertex(b) && valid_vertex(c))) {
-                s.bad[i] = 1;
-                return;
-            }
-            detail::setup_bounds_triangle(params, a, b, c, static_cast<std::uint32_t>(i), tris, pool);
-        }
-    });
-    for (std::size_t i = 0; i < items.size(); ++i)
-        if (s.bad[i]) return validate(items);
+    if (!s.front_end(width, height, items, threads)) return validate(items);
     if (items.size() >= kNoObject) return Error{"visibility pass: too many items (limit 2^32 - 1)"};
 
-    // Binning, in item order.
-    const int kTile = tile_side(width, height, threads);
-    const int tiles_x = (width + kTile - 1) / kTile;
-    const int tiles_y = (height + kTile - 1) / kTile;
-    const std::size_t tile_count = static_cast<std::size_t>(tiles_x) * static_cast<std::size_t>(tiles_y);
-    if (s.bins.size() < tile_count) {
-        s.bins.resize(tile_count);
-        s.frags.resize(tile_count);
-        s.hits.resize(tile_count);
+    const int side = tile_side(width, height, threads);
+    const TileGrid grid{side, (width + side - 1) / side, (height + side - 1) / side};
+    s.bin(items, grid);
+    const std::size_t pixels = grid.count() * grid.pixels();
+    if (s.min1.size() < pixels) {
+        s.min1.resize(pixels);
+        s.obj1.resize(pixels);
+        s.min2.resize(pixels);
     }
-    for (std::size_t t = 0; t < tile_count; ++t) s.bins[t].clear();
-    const bool one_tile = tile_count == 1;  // then every triangle is in it: no bin is built
-    for (std::size_t i = 0; i < items.size() && !one_tile; ++i) {
-        for (std::size_t k = 0; k < s.tris[i].size(); ++k) {
-            const detail::BoundsTri& t = s.tris[i][k];
-            for (int ty = t.y0 / kTile; ty <= t.y1 / kTile; ++ty)
-                for (int tx = t.x0 / kTile; tx <= t.x1 / kTile; ++tx)
-                    s.bins[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x) +
-                           static_cast<std::size_t>(tx)]
-                        .push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)});
-        }
-    }
-    const std::size_t tile_pixels = static_cast<std::size_t>(kTile) * static_cast<std::size_t>(kTile);
-    if (s.min1.size() < tile_count * tile_pixels) {
-        s.min1.resize(tile_count * tile_pixels);
-        s.obj1.resize(tile_count * tile_pixels);
-        s.min2.resize(tile_count * tile_pixels);
-    }
-    const std::uint32_t clear = DepthTarget::encode_clear(1.0, format);
-
-    // Per tile: every fragment's zmin into the two minima, then every fragment's zmax against the
-    // minimum over the other objects.
-    detail::run_parallel(threads, tile_count, [&](std::size_t tile) {
-        auto& bin = s.bins[tile];
-        auto& frags = s.frags[tile];
-        auto& hits = s.hits[tile];
-        frags.clear();
-        hits.clear();
-        if (bin.empty() && !one_tile) return;
-        const int tx = static_cast<int>(tile % static_cast<std::size_t>(tiles_x));
-        const int ty = static_cast<int>(tile / static_cast<std::size_t>(tiles_x));
-        const int x0 = tx * kTile, y0 = ty * kTile;
-        const int x1 = std::min(x0 + kTile, width) - 1, y1 = std::min(y0 + kTile, height) - 1;
-        std::uint32_t* min1 = s.min1.data() + tile * tile_pixels;
-        std::uint32_t* obj1 = s.obj1.data() + tile * tile_pixels;
-        std::uint32_t* min2 = s.min2.data() + tile * tile_pixels;
-        std::fill(min1, min1 + tile_pixels, clear);
-        std::fill(obj1, obj1 + tile_pixels, kNoObject);
-        std::fill(min2, min2 + tile_pixels, clear);
-        const auto draw = [&](const Ref r) __attribute__((always_inline)) {
-            const detail::BoundsTri& t = s.tris[r.item][r.tri];
-            const std::uint32_t obj = items[r.item].object;
-            const double mz = t.margin_z;
-            double last_lo = std::numeric_limits<double>::quiet_NaN(), last_hi = last_lo;
-            std::uint32_t zmin = 0, zmax = 0;  // quantized once per distinct depth
-            detail::bounds_pixels(t, s.pool[r.item].data(), std::max(x0, t.x0), std::max(y0, t.y0),
-                                  std::min(x1, t.x1), std::min(y1, t.y1), [&](int px, int py, double zlo, double zhi) {
-                                      const auto p = static_cast<std::uint32_t>((py - y0) * kTile + (px - x0));
-                                      if (!(zlo == last_lo)) {
-                                          last_lo = zlo;
-                                          zmin = detail::quantize_down(zlo - mz, format);
-                                      }
-                                      if (!(zhi == last_hi)) {
-                                          last_hi = zhi;
-                                          zmax = detail::quantize_up(zhi + mz, format);
-                                      }
-                                      if (obj == obj1[p]) {
-                                          min1[p] = std::min(min1[p], zmin);
-                                      } else if (zmin < min1[p]) {
-                                          min2[p] = min1[p];
-                                          min1[p] = zmin;
-                                          obj1[p] = obj;
-                                      } else {
-                                          min2[p] = std::min(min2[p], zmin);
-                                      }
-                                      frags.push_back({r.item, p, zmax});
-                                  });
-        };
-        if (one_tile) {
-            for (std::size_t i = 0; i < items.size(); ++i)
-                for (std::size_t k = 0; k < s.tris[i].size(); ++k)
-                    draw({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)});
-        } else {
-            for (const Ref& r : bin) draw(r);
-        }
-        // min1 is the minimum over all objects (with the clear value) and min2 the minimum over
-        // the objects other than obj1's, so the minimum over the objects other than o is min2 when
-        // o is obj1 and min1 otherwise (ties between objects: then min2 == min1).
-        std::uint32_t last = kNoObject;
-        for (const Fragment& f : frags) {
-            if (f.item == last) continue;
-            const std::uint32_t other = items[f.item].object == obj1[f.pixel] ? min2[f.pixel] : min1[f.pixel];
-            if (f.zmax >= other) {  // the GEQUAL query passes here
-                hits.push_back(f.item);
-                last = f.item;
-            }
-        }
-    });
+    detail::parallel_for(threads, grid.count(),
+                         [&](std::size_t tile) { s.shade(items, grid, width, height, format, tile); });
 
     std::vector<std::uint8_t> result(items.size(), 0);
-    for (std::size_t t = 0; t < tile_count; ++t)
+    for (std::size_t t = 0; t < grid.count(); ++t)
         for (const std::uint32_t i : s.hits[t]) result[i] = 1;
     return result;
 }

@@ -4,9 +4,9 @@
 // Status. The message names what is wrong and where ("file.obj:12: face index 9 is beyond the
 // vertex list (size 8)"). A failed call changes nothing the caller can see.
 //
-// cullide sits on top of raster, so it uses raster's error type rather than a third copy of the
-// same fifty lines (spatialhash keeps its own: it must not depend on raster). Interface: ok(),
-// explicit operator bool, value() (asserts ok()), error().message.
+// The one error type of the project (outcome/result.h, through raster's names), so cullide::Error,
+// raster::Error and spatialhash::Error are the same type. Interface: ok(), explicit operator bool,
+// value() (asserts ok()), error().message.
 #pragma once
 
 #include "raster/result.h"

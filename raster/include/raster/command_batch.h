@@ -53,7 +53,10 @@ class CommandBatch {
     std::vector<QueryKind> query_kinds_;
 };
 
-// How execute() runs. threads = 0: one (the serial executor is used when built without oneTBB).
+// How execute() runs. threads: the worker count, 0 = all hardware threads (the one rule of the
+// project: docs/architecture.md, "Threading"); negative counts are an error. The caller owns
+// threading, so the default is one. Built without oneTBB, every count runs serially. Results never
+// depend on it.
 struct ExecuteOptions {
     int threads = 1;
     bool allow_simd = true;  // false: always the portable kernel (tests compare the two)

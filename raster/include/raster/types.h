@@ -42,34 +42,28 @@ struct Viewport {
     int height = 0;
 };
 
-// A clip-space vertex (x, y, z, w), as gl_Position.
-struct Float4 {
-    float x = 0.0f;
-    float y = 0.0f;
-    float z = 0.0f;
-    float w = 1.0f;
+// A clip-space vertex (x, y, z, w), as gl_Position: Float4 for GL-exact input, Double4 (double
+// precision, w must be 1) for the exact-bounds mode. One template, so the two cannot drift apart.
+template <class T>
+struct Vertex4 {
+    T x = 0;
+    T y = 0;
+    T z = 0;
+    T w = 1;
 };
+using Float4 = Vertex4<float>;
+using Double4 = Vertex4<double>;
 
 // Non-owning view of an indexed triangle mesh in clip space; three indices per triangle. The
-// spans must stay valid until the batch that holds the view has been executed.
-struct MeshView {
-    std::span<const Float4> vertices;
+// spans must stay valid until the batch that holds the view has been executed. MeshView holds
+// Float4 vertices; MeshViewD double ones (clip space, orthographic: w = 1), same lifetime rule.
+template <class Vertex>
+struct IndexedMeshView {
+    std::span<const Vertex> vertices;
     std::span<const std::uint32_t> indices;
 };
-
-// A clip-space vertex in double precision, for the exact-bounds mode (w must be 1).
-struct Double4 {
-    double x = 0;
-    double y = 0;
-    double z = 0;
-    double w = 1;
-};
-
-// MeshView with double vertices (clip space, orthographic: w = 1). Same lifetime rule as MeshView.
-struct MeshViewD {
-    std::span<const Double4> vertices;
-    std::span<const std::uint32_t> indices;
-};
+using MeshView = IndexedMeshView<Float4>;
+using MeshViewD = IndexedMeshView<Double4>;
 
 // The GL state one draw runs under. GL_DEPTH_TEST is always on (use DepthFunc::Always for "no test").
 struct DrawState {

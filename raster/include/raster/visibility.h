@@ -53,6 +53,7 @@ class VisibilityPass {
     // sample), 0 when it is fully visible with respect to every other object's items, on a
     // width x height target of `format` cleared to 1, in the exact-bounds mode (full viewport). Fails,
     // naming the item, triangle position and vertex, on invalid input (nothing is computed then).
+    // threads: workers, 0 = all hardware threads, negative = an error; the answer never depends on it.
     [[nodiscard]] Result<std::vector<std::uint8_t>> run(int width, int height, DepthFormat format,
                                                         std::span<const VisibilityItem> items, int threads);
 

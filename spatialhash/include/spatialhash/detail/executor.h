@@ -4,7 +4,10 @@
 // (chunks of kChunk elements) and merge per-item results in item order, so every output is
 // identical for any thread count. With oneTBB (CULLIDE_HAVE_TBB) items run in a
 // tbb::task_arena of the requested size; without it they run serially in order. No TBB type
-// appears here.
+// appears here. Thread counts follow the project's one rule (0 = all hardware threads); raster has
+// the same primitive for raster and cullide (raster/detail/parallel.h), but spatialhash must not
+// depend on raster, and this executor keeps its arena in the caller's Workspace between frames
+// (docs/architecture.md, "Threading").
 #pragma once
 
 #include <cstddef>

@@ -1,4 +1,5 @@
-// pipeline.cpp: llvmpipe's triangle front end and the per-rectangle back end. See pipeline.h.
+// triangle_setup.cpp: llvmpipe's triangle front end (clipping, viewport, 16.8 snapping, edge and
+// depth-plane setup: setup_triangle). See pipeline.h.
 #include "pipeline.h"
 
 #include "raster/command_batch.h"
@@ -247,21 +248,6 @@ void setup_triangle(const FrontEndParams& params, const Float4& a, const Float4&
     }
     // The polygon as a fan, provoking vertex (the first) last in each triangle.
     for (int i = 2; i < n; ++i) setup_window_triangle(params, inlist[i - 1], inlist[i], inlist[0], draw, out);
-}
-
-bool simd_allowed_by_environment() {
-    static const bool ok = [] {
-        const char* v = std::getenv("CULLIDE_RASTER_NO_SIMD");
-        return v == nullptr || v[0] == '\0' || (v[0] == '0' && v[1] == '\0');
-    }();
-    return ok;
-}
-
-std::uint64_t raster_rect(const SetupTri& tri, DepthFormat format, DepthFunc func, bool write, std::uint32_t* depth,
-                          int stride, int rx0, int ry0, int rx1, int ry1, bool allow_simd, bool stop_at_first) {
-    if (allow_simd && kernel_avx2_available() && simd_allowed_by_environment())
-        return raster_rect_avx2(tri, format, func, write, depth, stride, rx0, ry0, rx1, ry1, stop_at_first);
-    return raster_rect_portable(tri, format, func, write, depth, stride, rx0, ry0, rx1, ry1, stop_at_first);
 }
 
 }  // namespace raster::detail
