@@ -34,48 +34,38 @@ void split_words(std::string_view s, std::vector<std::string_view>& out) {
     }
 }
 
+namespace {
+
+// The whole token is one number for std::from_chars: one leading '+' is accepted (from_chars rejects
+// it) when a digit or point follows, anything left over is a syntax error.
+template <class T, class... Format>
+NumberStatus parse_token(std::string_view token, T& out, Format... format) {
+    if (!token.empty() && token.front() == '+') {
+        token.remove_prefix(1);
+        if (!token.empty() && (token.front() == '+' || token.front() == '-')) return NumberStatus::Syntax;
+    }
+    if (token.empty()) return NumberStatus::Syntax;
+    T value{};
+    const char* end = token.data() + token.size();
+    const auto [ptr, ec] = std::from_chars(token.data(), end, value, format...);
+    if (ec == std::errc::result_out_of_range) return NumberStatus::OutOfRange;
+    if (ec != std::errc{} || ptr != end) return NumberStatus::Syntax;
+    out = value;
+    return NumberStatus::Ok;
+}
+
+}  // namespace
+
 NumberStatus parse_real(std::string_view token, double& out) {
-    // from_chars rejects a leading '+'; accept exactly one, followed by the number proper.
-    if (!token.empty() && token.front() == '+') {
-        token.remove_prefix(1);
-        if (token.empty() || token.front() == '+' || token.front() == '-') return NumberStatus::Syntax;
-    }
-    if (token.empty()) return NumberStatus::Syntax;
-    double value = 0;
-    const char* end = token.data() + token.size();
-    const auto [ptr, ec] = std::from_chars(token.data(), end, value, std::chars_format::general);
-    if (ec == std::errc::result_out_of_range) return NumberStatus::OutOfRange;
-    if (ec != std::errc{} || ptr != end) return NumberStatus::Syntax;
-    out = value;
-    return std::isfinite(value) ? NumberStatus::Ok : NumberStatus::NonFinite;
+    const NumberStatus s = parse_token(token, out, std::chars_format::general);
+    if (s != NumberStatus::Ok) return s;
+    return std::isfinite(out) ? NumberStatus::Ok : NumberStatus::NonFinite;
 }
 
-NumberStatus parse_integer(std::string_view token, std::int64_t& out) {
-    if (!token.empty() && token.front() == '+') {
-        token.remove_prefix(1);
-        if (token.empty() || token.front() == '-') return NumberStatus::Syntax;
-    }
-    if (token.empty()) return NumberStatus::Syntax;
-    std::int64_t value = 0;
-    const char* end = token.data() + token.size();
-    const auto [ptr, ec] = std::from_chars(token.data(), end, value);
-    if (ec == std::errc::result_out_of_range) return NumberStatus::OutOfRange;
-    if (ec != std::errc{} || ptr != end) return NumberStatus::Syntax;
-    out = value;
-    return NumberStatus::Ok;
-}
+NumberStatus parse_integer(std::string_view token, std::int64_t& out) { return parse_token(token, out); }
 
-NumberStatus parse_unsigned(std::string_view token, std::uint64_t& out) {
-    if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-    if (token.empty() || token.front() == '-' || token.front() == '+') return NumberStatus::Syntax;
-    std::uint64_t value = 0;
-    const char* end = token.data() + token.size();
-    const auto [ptr, ec] = std::from_chars(token.data(), end, value);
-    if (ec == std::errc::result_out_of_range) return NumberStatus::OutOfRange;
-    if (ec != std::errc{} || ptr != end) return NumberStatus::Syntax;
-    out = value;
-    return NumberStatus::Ok;
-}
+// from_chars for an unsigned type already refuses a '-'.
+NumberStatus parse_unsigned(std::string_view token, std::uint64_t& out) { return parse_token(token, out); }
 
 std::string quote(std::string_view token) {
     constexpr std::size_t kMaxShown = 40;
