@@ -29,6 +29,9 @@ class EmulatorDevice final : public QueryDevice {
                                                       std::span<const raster::VisibilityItem> items) override;
     std::string name() const override { return "emulator"; }
 
+    // The current target (nullptr before the first clear), for tests of the partial clear.
+    [[nodiscard]] const raster::DepthTarget* target() const { return target_ ? &*target_ : nullptr; }
+
    private:
     // Widens row y's written span to [x0, x1] (clamped to the target).
     void mark(int y, int x0, int x1);
