@@ -164,7 +164,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const cullide::Result<std::vector<cullide::TrianglePair>> want = cullide::exact_pairs(scene, exact_opt);
     for (const cullide::Method method : {cullide::Method::RCullide, cullide::Method::RCullideOffset}) {
         opt.method = method;
-        const cullide::Result<cullide::FrameResult> got = cullide::process_frame(scene, opt);
+        // One context for the whole run: a frame's results never depend on what ran through it
+        // before (tests/cullide/frame_context_test.cpp), and it spares each input the device and
+        // depth-buffer set-up (cullide/pipeline.h).
+        static cullide::FrameContext context;
+        const cullide::Result<cullide::FrameResult> got = cullide::process_frame(scene, opt, context);
         if (!want) {
             if (got) fail(scene, opt, "exact_pairs rejected the scene (" + want.error().message + ") but process_frame ran");
             continue;

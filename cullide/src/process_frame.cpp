@@ -5,10 +5,29 @@
 #include <chrono>
 #include <memory>
 
+#include "emulator_device.h"
 #include "spatialhash/broad_phase.h"
 
 namespace cullide {
+
+// What a FrameContext holds (pipeline.h): the emulator device, made on the first visibility frame
+// that runs on it and kept with its depth target.
+struct FrameContext::State {
+    std::unique_ptr<detail::EmulatorDevice> device;
+};
+
+FrameContext::FrameContext() : state_(std::make_unique<State>()) {}
+FrameContext::~FrameContext() = default;
+FrameContext::FrameContext(FrameContext&&) noexcept = default;
+FrameContext& FrameContext::operator=(FrameContext&&) noexcept = default;
+
 namespace {
+
+// Frames of at most this many triangles run on the calling thread whatever RunOptions::threads
+// says: starting a oneTBB arena for each parallel step costs more than such a frame's whole work
+// (a 2-triangle rcullide frame: about 640 us with two workers, 100 us on one; docs/cullide.md,
+// "Tiny frames"). Results never depend on the thread count, so this changes times only.
+constexpr std::uint64_t kSerialFrameTriangles = 64;
 
 template <class E, std::size_t N>
 Result<E> parse_name(std::string_view what, std::string_view name, const std::pair<const char*, E> (&table)[N]) {
@@ -102,12 +121,14 @@ Status run_exact(std::span<const Mesh> objects, const std::vector<std::uint32_t>
 // visibility.h), its shared statistics come back as they are (VisibilityStats); the resolution is
 // checked and defaulted by the method's entry point.
 Status run_visibility(std::span<const Mesh> objects, const std::vector<std::uint32_t>& active, const RunOptions& o,
-                      FrameResult& result) {
-    std::unique_ptr<QueryDevice> own;
+                      FrameContext::State& context, FrameResult& result) {
     QueryDevice* device = o.device;
     if (device == nullptr) {
-        own = make_emulator_device(o.threads);
-        device = own.get();
+        if (!context.device)
+            context.device = std::make_unique<detail::EmulatorDevice>(o.threads);
+        else
+            context.device->set_threads(o.threads);
+        device = context.device.get();
     }
     FrameStats& st = result.stats;
     Result<std::vector<TrianglePair>> pairs = Error{};
@@ -173,6 +194,13 @@ int default_resolution(Method m) {
 }
 
 Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOptions& options) {
+    FrameContext context;
+    return process_frame(objects, options, context);
+}
+
+Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOptions& options, FrameContext& context) {
+    // A moved-from context has no state; give it a fresh one rather than fail.
+    if (!context.state_) context.state_ = std::make_unique<FrameContext::State>();
     if (options.threads < 0) return Error{"threads must be >= 0 (got " + std::to_string(options.threads) + ")"};
     if (options.self && options.method != Method::Exact && options.method != Method::QCullide &&
         options.method != Method::QCullideGL)
@@ -188,16 +216,19 @@ Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOption
     FrameResult result;
     FrameStats& st = result.stats;
     for (const Mesh& m : objects) st.triangles += m.triangles.size();
+    RunOptions run = options;
+    if (st.triangles <= kSerialFrameTriangles) run.threads = 1;
 
     const auto bp_start = std::chrono::steady_clock::now();
-    Result<std::vector<std::uint32_t>> active = broad_phase(objects, options, st);
+    Result<std::vector<std::uint32_t>> active = broad_phase(objects, run, st);
     if (!active) return active.error();
     st.broadphase_objects = active.value().size();
     st.broadphase_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - bp_start).count();
 
-    Status ran = options.method == Method::Exact ? run_exact(objects, active.value(), options, result)
-                                                 : run_visibility(objects, active.value(), options, result);
+    Status ran = run.method == Method::Exact
+                     ? run_exact(objects, active.value(), run, result)
+                     : run_visibility(objects, active.value(), run, *context.state_, result);
     if (!ran) return ran.error();
     result.object_pairs = object_pairs(result.pairs);
     st.objects = objects.size();

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -90,7 +91,33 @@ struct FrameResult {
     FrameStats stats;
 };
 
-// Runs one frame. Fails on invalid meshes or options, naming what is wrong.
+// What process_frame keeps from one frame to the next when the caller holds it: the emulator device
+// with its depth target, and whether small frames run serially. A frame costs milliseconds of
+// set-up without one (a depth target allocated and cleared, worker threads woken) and microseconds
+// with one, which is what fuzzers and per-frame simulation loops need (docs/cullide.md, "Tiny
+// frames"). It holds no answer: a frame's results are the same bits with a fresh context, a reused
+// one, or none, whatever frames of whatever sizes, methods and options ran through it before.
+// Movable, not copyable; one frame at a time (not for concurrent calls from several threads).
+class FrameContext {
+   public:
+    FrameContext();
+    ~FrameContext();
+    FrameContext(FrameContext&&) noexcept;
+    FrameContext& operator=(FrameContext&&) noexcept;
+    FrameContext(const FrameContext&) = delete;
+    FrameContext& operator=(const FrameContext&) = delete;
+
+    struct State;  // defined in src/process_frame.cpp
+
+   private:
+    friend Result<FrameResult> process_frame(std::span<const Mesh>, const RunOptions&, FrameContext&);
+    std::unique_ptr<State> state_;
+};
+
+// Runs one frame. Fails on invalid meshes or options, naming what is wrong (the context keeps its
+// buffers and stays usable). The first form uses a temporary FrameContext.
 [[nodiscard]] Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOptions& options);
+[[nodiscard]] Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOptions& options,
+                                                FrameContext& context);
 
 }  // namespace cullide
