@@ -310,7 +310,17 @@ class TaskBuilder {
         add(std::move(refs), from_i, &common);
     }
 
-    std::vector<Task> take_tasks() { return std::move(tasks_); }
+    // The tasks added, in the order added; made on up to `threads` workers (binning a task is the
+    // stage's largest serial cost otherwise).
+    std::vector<Task> take_tasks(int threads) {
+        std::vector<Task> tasks(pending_.size());
+        parallel_chunks(threads, pending_.size(), [&](std::size_t t) {
+            PendingTask& p = pending_[t];
+            tasks[t] = make_task(std::move(p.refs), p.first_count, p.self ? nullptr : &p.common);
+        });
+        pending_.clear();
+        return tasks;
+    }
 
     std::uint64_t task_triangles() const {
         std::uint64_t n = 0;
@@ -324,13 +334,17 @@ class TaskBuilder {
         return {set.box, set.object, s, set.count == 1 ? set.first : kWholeSet};
     }
 
-    // Chooses the axis, replaces loose sets by their triangles inside `common` and bins the refs
-    // (bin_task). A self task (no `common`) always sweeps
-    // triangles: a set's own pairs are pairs of its triangles.
     // `refs` come object by object: the first object's first_count, then the second's (self: one
-    // object, first_count unused).
+    // object, first_count unused). The task is made later, in parallel (take_tasks).
     void add(std::vector<SweepRef>&& refs, std::size_t first_count, const Aabb* common) {
         if (refs.size() < 2 && (common != nullptr || refs.empty() || sets_[refs[0].set].count < 2)) return;
+        pending_.push_back({std::move(refs), first_count, common != nullptr ? *common : Aabb{}, common == nullptr});
+    }
+
+    // Chooses the axis, replaces loose sets by their triangles inside the common box and bins the
+    // refs (bin_task). A self task (no common box) always sweeps triangles: a set's own pairs are
+    // pairs of its triangles. Reads only the builder's inputs, so tasks are made concurrently.
+    Task make_task(std::vector<SweepRef>&& refs, std::size_t first_count, const Aabb* common) const {
         Task task;
         task.self = common == nullptr;
         task.axis = spread_axis(refs);
@@ -359,7 +373,7 @@ class TaskBuilder {
                     bounds.hi[k] = std::max(bounds.hi[k], r.box.hi[k]);
                 }
         bin_task(task, refs, first_count, bounds);
-        tasks_.push_back(std::move(task));
+        return task;
     }
 
     // Sets whose boxes' summed extent along `axis` is more than 4 times their triangles' (on the
@@ -380,7 +394,13 @@ class TaskBuilder {
     std::span<const CandidateSet> sets_;
     std::vector<std::uint32_t> set_begin_;  // sets of object o: [set_begin_[o], set_begin_[o + 1])
     std::vector<char> in_task_;
-    std::vector<Task> tasks_;
+    struct PendingTask {
+        std::vector<SweepRef> refs;
+        std::size_t first_count = 0;
+        Aabb common;
+        bool self = false;
+    };
+    std::vector<PendingTask> pending_;
 };
 
 }  // namespace
@@ -435,7 +455,7 @@ ExactStageResult sweep_exact_stage(std::span<const ExactObject> objects, std::sp
         for (std::uint32_t o = 0; o < n; ++o) builder.add_self(o);
     for (std::uint32_t i = 0; i < n; ++i)
         for (std::uint32_t j = i + 1; j < n; ++j) builder.add_pair(i, j);
-    std::vector<Task> tasks = builder.take_tasks();
+    std::vector<Task> tasks = builder.take_tasks(options.threads);
 
     // Units: runs of consecutive cells of one task holding about kSweepChunk refs (fixed by the
     // input), so a big task (a bunny inside a dragon) spreads over threads.
