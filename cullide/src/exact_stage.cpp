@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 #include "cullide/tri_tri.h"
 #include "parallel.h"
@@ -100,12 +101,172 @@ ExactStageResult merge(std::vector<UnitOut>& units, bool count_set_pairs) {
     return r;
 }
 
-// One swept task: the refs of one object (self) or of two, sorted along `axis`.
+// One swept task: the refs of one object (self) or of two, binned into a grid of cells over the
+// two axes other than the sweep axis, each cell's refs sorted along `axis`. A 1-D sweep alone met
+// about 650 box intervals per 3-D overlap on tori and 4000 on bunny-dragon (long surfaces project onto
+// any one axis densely); a cell meets only the refs near it. A ref sits in every cell its box touches,
+// and a pair is visited only in the cell holding the low corner of its boxes' intersection
+// (max of the two cells of the boxes' lows), so each overlapping pair is visited once, as before.
+// A ref in a cell, with the cell of its box's low corner (u | v << 16): 64 bytes.
+struct CellRef {
+    SweepRef ref;
+    std::uint32_t low_cell = 0;
+};
+
 struct Task {
-    std::vector<SweepRef> refs;
+    std::vector<CellRef> refs;              // cell by cell; in a cell the first object's refs, then
+                                            // the second's (self: all one run); each run is sorted
+                                            // along `axis` by the unit that sweeps the cell (sorting
+                                            // small runs in parallel beats one big serial sort)
+    std::vector<std::uint32_t> cell_begin;  // cell c: refs [cell_begin[c], cell_begin[c + 1])
+    std::vector<std::uint32_t> cell_split;  // cell c: the second object's refs start there
     int axis = 0;
+    int grid_u = 1, grid_v = 1;             // cells along the two other axes
     bool self = false;
 };
+
+// The grid over the common box: cell of coordinate x along an axis is floor((x - lo) * scale),
+// clamped; monotone in x, so the cell of max(lo_a, lo_b) is the larger of the two low cells.
+struct GridAxis {
+    int axis = 0, cells = 1;
+    double lo = 0.0, scale = 0.0;
+    [[nodiscard]] std::uint32_t cell(double x) const {
+        if (cells == 1) return 0;
+        const double c = std::floor((x - lo) * scale);
+        return static_cast<std::uint32_t>(std::clamp(c, 0.0, static_cast<double>(cells - 1)));
+    }
+};
+
+// Cells along one axis: about kCellPerExtent mean ref extents per cell (a ref then touches few cells),
+// at most kMaxCellsPerAxis.
+constexpr double kCellPerExtent = 4.0;
+constexpr int kMaxCellsPerAxis = 256;
+// A cell should hold about this many refs at least, so binning costs less than it saves.
+constexpr std::size_t kRefsPerCell = 16;
+
+GridAxis make_grid_axis(std::span<const SweepRef> refs, const Aabb& bounds, int axis, int max_cells) {
+    GridAxis g;
+    g.axis = axis;
+    const double extent = bounds.hi[axis] - bounds.lo[axis];
+    if (!(extent > 0.0) || refs.empty() || max_cells <= 1) return g;
+    double sum = 0.0;
+    for (const SweepRef& r : refs)
+        sum += std::min(r.box.hi[axis], bounds.hi[axis]) - std::max(r.box.lo[axis], bounds.lo[axis]);
+    const double mean = sum / static_cast<double>(refs.size());
+    const double want = mean > 0.0 ? extent / (kCellPerExtent * mean) : static_cast<double>(max_cells);
+    g.cells = static_cast<int>(std::clamp(want, 1.0, static_cast<double>(std::min(max_cells, kMaxCellsPerAxis))));
+    g.lo = bounds.lo[axis];
+    g.scale = static_cast<double>(g.cells) / extent;
+    return g;
+}
+
+// Bins `refs` (the first `first_count` are the first object's) into the grid over `bounds`: count,
+// scan, fill, so each cell holds each side's refs as one run.
+void bin_task(Task& task, const std::vector<SweepRef>& refs, std::size_t first_count, const Aabb& bounds) {
+    const int u = (task.axis + 1) % 3, v = (task.axis + 2) % 3;
+    const std::size_t budget = std::max<std::size_t>(1, refs.size() / kRefsPerCell);
+    GridAxis gu = make_grid_axis(refs, bounds, u, static_cast<int>(std::min<std::size_t>(budget, kMaxCellsPerAxis)));
+    const std::size_t left = std::max<std::size_t>(1, budget / static_cast<std::size_t>(gu.cells));
+    GridAxis gv = make_grid_axis(refs, bounds, v, static_cast<int>(std::min<std::size_t>(left, kMaxCellsPerAxis)));
+    task.grid_u = gu.cells;
+    task.grid_v = gv.cells;
+    const std::size_t cells = static_cast<std::size_t>(gu.cells) * static_cast<std::size_t>(gv.cells);
+    struct Span {
+        std::uint32_t u0, u1, v0, v1;
+    };
+    std::vector<Span> spans(refs.size());
+    // counts[2 * c + side]: refs of each side per cell.
+    std::vector<std::uint32_t> counts(2 * cells + 1, 0);
+    for (std::size_t i = 0; i < refs.size(); ++i) {
+        const Aabb& b = refs[i].box;
+        spans[i] = {gu.cell(b.lo[u]), gu.cell(b.hi[u]), gv.cell(b.lo[v]), gv.cell(b.hi[v])};
+        const std::size_t side = i < first_count ? 0 : 1;
+        for (std::uint32_t cv = spans[i].v0; cv <= spans[i].v1; ++cv)
+            for (std::uint32_t cu = spans[i].u0; cu <= spans[i].u1; ++cu) ++counts[2 * (cv * gu.cells + cu) + side];
+    }
+    std::vector<std::uint32_t> next(2 * cells + 1, 0);
+    for (std::size_t k = 0; k < 2 * cells; ++k) next[k + 1] = next[k] + counts[k];
+    task.cell_begin.resize(cells + 1);
+    task.cell_split.resize(cells);
+    for (std::size_t c = 0; c < cells; ++c) {
+        task.cell_begin[c] = next[2 * c];
+        task.cell_split[c] = next[2 * c + 1];
+    }
+    task.cell_begin[cells] = next[2 * cells];
+    task.refs.resize(next[2 * cells]);
+    for (std::size_t i = 0; i < refs.size(); ++i) {
+        const std::size_t side = i < first_count ? 0 : 1;
+        const std::uint32_t low = spans[i].u0 | (spans[i].v0 << 16);
+        for (std::uint32_t cv = spans[i].v0; cv <= spans[i].v1; ++cv) {
+            for (std::uint32_t cu = spans[i].u0; cu <= spans[i].u1; ++cu) {
+                task.refs[next[2 * (cv * gu.cells + cu) + side]++] = {refs[i], low};
+            }
+        }
+    }
+}
+
+// Whether cell (cu, cv) holds the low corner of the intersection of boxes with low cells a and b.
+inline bool owns_pair(std::uint32_t cell_uv, std::uint32_t a, std::uint32_t b) {
+    const std::uint32_t u = std::max(a & 0xffffu, b & 0xffffu), v = std::max(a >> 16, b >> 16);
+    return (u | (v << 16)) == cell_uv;
+}
+
+// Sorts each run of cell c along the axis by (lo, set, part): a unique key, so the order does not
+// depend on the sort algorithm.
+void sort_cell(Task& task, std::size_t c) {
+    const int axis = task.axis;
+    const auto less = [axis](const CellRef& x, const CellRef& y) {
+        const SweepRef& a = x.ref;
+        const SweepRef& b = y.ref;
+        if (a.box.lo[axis] != b.box.lo[axis]) return a.box.lo[axis] < b.box.lo[axis];
+        if (a.set != b.set) return a.set < b.set;
+        return a.part < b.part;
+    };
+    const auto base = task.refs.begin();
+    std::sort(base + task.cell_begin[c], base + task.cell_split[c], less);
+    std::sort(base + task.cell_split[c], base + task.cell_begin[c + 1], less);
+}
+
+// Visits every overlapping pair of refs owned by cell c of `task` (see Task), its runs sorted
+// (sort_cell): a sweep of the cell's one run (self) or a two-run sweep (the pairs of one side are
+// never met, unlike one merged run).
+template <class Visit>
+void sweep_cell(const Task& task, std::size_t c, Visit&& visit) {
+    const std::uint32_t cell_uv = static_cast<std::uint32_t>(c % static_cast<std::size_t>(task.grid_u)) |
+                                  static_cast<std::uint32_t>(c / static_cast<std::size_t>(task.grid_u)) << 16;
+    const int axis = task.axis;
+    const CellRef* cell_refs = task.refs.data();
+    const std::size_t begin = task.cell_begin[c], split = task.cell_split[c], end = task.cell_begin[c + 1];
+    const auto try_pair = [&](std::size_t i, std::size_t j) {
+        const CellRef& a = cell_refs[i];
+        const CellRef& b = cell_refs[j];
+        if (overlaps(a.ref.box, b.ref.box) && owns_pair(cell_uv, a.low_cell, b.low_cell)) visit(a.ref, b.ref);
+    };
+    const auto lo = [&](std::size_t i) { return cell_refs[i].ref.box.lo[axis]; };
+    const auto hi = [&](std::size_t i) { return cell_refs[i].ref.box.hi[axis]; };
+    if (task.self) {
+        for (std::size_t i = begin; i < end; ++i) {
+            const double i_hi = hi(i);
+            for (std::size_t j = i + 1; j < end && lo(j) <= i_hi; ++j) try_pair(i, j);
+        }
+        return;
+    }
+    // Two sorted runs: the ref with the lower low (ties: the first run's) meets the other run's refs
+    // from its cursor on while they start before it ends; every pair overlapping along the axis is
+    // met once, from the one that starts first.
+    std::size_t i = begin, j = split;
+    while (i < split && j < end) {
+        if (lo(i) <= lo(j)) {
+            const double i_hi = hi(i);
+            for (std::size_t k = j; k < end && lo(k) <= i_hi; ++k) try_pair(i, k);
+            ++i;
+        } else {
+            const double j_hi = hi(j);
+            for (std::size_t k = i; k < split && lo(k) <= j_hi; ++k) try_pair(k, j);
+            ++j;
+        }
+    }
+}
 
 // Builds the tasks of sweep_exact_stage (see exact_stage.h); `in_task` flags the sets in some task's
 // common box.
@@ -118,13 +279,12 @@ class TaskBuilder {
     }
 
     void add_self(std::uint32_t o) {
-        Task task;
-        task.self = true;
+        std::vector<SweepRef> refs;
         for (std::uint32_t s = set_begin_[o]; s < set_begin_[o + 1]; ++s) {
             in_task_[s] = 1;
-            task.refs.push_back(whole_ref(s));
+            refs.push_back(whole_ref(s));
         }
-        add(std::move(task), nullptr);
+        add(std::move(refs), 0, nullptr);
     }
 
     void add_pair(std::uint32_t i, std::uint32_t j) {
@@ -136,21 +296,31 @@ class TaskBuilder {
             common.lo[k] = std::max(bi.lo[k], bj.lo[k]);
             common.hi[k] = std::min(bi.hi[k], bj.hi[k]);
         }
-        Task task;
+        std::vector<SweepRef> refs;
         std::size_t from_i = 0;
         for (const std::uint32_t o : {i, j}) {
             for (std::uint32_t s = set_begin_[o]; s < set_begin_[o + 1]; ++s) {
                 if (!overlaps(sets_[s].box, common)) continue;
                 in_task_[s] = 1;
-                task.refs.push_back(whole_ref(s));
+                refs.push_back(whole_ref(s));
             }
-            if (o == i) from_i = task.refs.size();
+            if (o == i) from_i = refs.size();
         }
-        if (from_i == 0 || from_i == task.refs.size()) return;  // one side has nothing there
-        add(std::move(task), &common);
+        if (from_i == 0 || from_i == refs.size()) return;  // one side has nothing there
+        add(std::move(refs), from_i, &common);
     }
 
-    std::vector<Task> take_tasks() { return std::move(tasks_); }
+    // The tasks added, in the order added; made on up to `threads` workers (binning a task is the
+    // stage's largest serial cost otherwise).
+    std::vector<Task> take_tasks(int threads) {
+        std::vector<Task> tasks(pending_.size());
+        parallel_chunks(threads, pending_.size(), [&](std::size_t t) {
+            PendingTask& p = pending_[t];
+            tasks[t] = make_task(std::move(p.refs), p.first_count, p.self ? nullptr : &p.common);
+        });
+        pending_.clear();
+        return tasks;
+    }
 
     std::uint64_t task_triangles() const {
         std::uint64_t n = 0;
@@ -164,26 +334,46 @@ class TaskBuilder {
         return {set.box, set.object, s, set.count == 1 ? set.first : kWholeSet};
     }
 
-    // Chooses the axis, replaces loose sets by their triangles inside `common`, and sorts. A self
-    // task (no `common`) always sweeps triangles: a set's own pairs are pairs of its triangles.
-    void add(Task&& task, const Aabb* common) {
-        if (task.refs.size() < 2 && (common != nullptr || task.refs.empty() || sets_[task.refs[0].set].count < 2))
-            return;
-        task.axis = spread_axis(task.refs);
-        const bool all_triangles = std::all_of(task.refs.begin(), task.refs.end(),
-                                               [](const SweepRef& r) { return r.part != kWholeSet; });
-        if (!all_triangles && (common == nullptr || loose(task.refs, task.axis))) {
+    // `refs` come object by object: the first object's first_count, then the second's (self: one
+    // object, first_count unused). The task is made later, in parallel (take_tasks).
+    void add(std::vector<SweepRef>&& refs, std::size_t first_count, const Aabb* common) {
+        if (refs.size() < 2 && (common != nullptr || refs.empty() || sets_[refs[0].set].count < 2)) return;
+        pending_.push_back({std::move(refs), first_count, common != nullptr ? *common : Aabb{}, common == nullptr});
+    }
+
+    // Chooses the axis, replaces loose sets by their triangles inside the common box and bins the
+    // refs (bin_task). A self task (no common box) always sweeps triangles: a set's own pairs are
+    // pairs of its triangles. Reads only the builder's inputs, so tasks are made concurrently.
+    Task make_task(std::vector<SweepRef>&& refs, std::size_t first_count, const Aabb* common) const {
+        Task task;
+        task.self = common == nullptr;
+        task.axis = spread_axis(refs);
+        const bool all_triangles =
+            std::all_of(refs.begin(), refs.end(), [](const SweepRef& r) { return r.part != kWholeSet; });
+        if (!all_triangles && (common == nullptr || loose(refs, task.axis))) {
             std::vector<SweepRef> tris;
-            for (const SweepRef& r : task.refs) {
+            for (const SweepRef& r : refs) {
                 const CandidateSet& set = sets_[r.set];
                 const std::span<const Aabb> boxes = objects_[set.object].triangle_boxes;
                 for (std::uint32_t p = set.first; p < set.first + set.count; ++p)
                     if (common == nullptr || overlaps(boxes[p], *common)) tris.push_back({boxes[p], set.object, r.set, p});
             }
-            task.refs = std::move(tris);
+            refs = std::move(tris);  // still object by object
+            if (common != nullptr)
+                first_count = static_cast<std::size_t>(
+                    std::find_if(refs.begin(), refs.end(), [&](const SweepRef& r) { return r.object != refs[0].object; }) -
+                    refs.begin());
         }
-        sort_along(task.refs, task.axis);
-        tasks_.push_back(std::move(task));
+        if (task.self) first_count = refs.size();
+        Aabb bounds = common != nullptr ? *common : refs.front().box;
+        if (common == nullptr)
+            for (const SweepRef& r : refs)
+                for (int k = 0; k < 3; ++k) {
+                    bounds.lo[k] = std::min(bounds.lo[k], r.box.lo[k]);
+                    bounds.hi[k] = std::max(bounds.hi[k], r.box.hi[k]);
+                }
+        bin_task(task, refs, first_count, bounds);
+        return task;
     }
 
     // Sets whose boxes' summed extent along `axis` is more than 4 times their triangles' (on the
@@ -204,7 +394,13 @@ class TaskBuilder {
     std::span<const CandidateSet> sets_;
     std::vector<std::uint32_t> set_begin_;  // sets of object o: [set_begin_[o], set_begin_[o + 1])
     std::vector<char> in_task_;
-    std::vector<Task> tasks_;
+    struct PendingTask {
+        std::vector<SweepRef> refs;
+        std::size_t first_count = 0;
+        Aabb common;
+        bool self = false;
+    };
+    std::vector<PendingTask> pending_;
 };
 
 }  // namespace
@@ -259,21 +455,31 @@ ExactStageResult sweep_exact_stage(std::span<const ExactObject> objects, std::sp
         for (std::uint32_t o = 0; o < n; ++o) builder.add_self(o);
     for (std::uint32_t i = 0; i < n; ++i)
         for (std::uint32_t j = i + 1; j < n; ++j) builder.add_pair(i, j);
-    const std::vector<Task> tasks = builder.take_tasks();
+    std::vector<Task> tasks = builder.take_tasks(options.threads);
 
+    // Units: runs of consecutive cells of one task holding about kSweepChunk refs (fixed by the
+    // input), so a big task (a bunny inside a dragon) spreads over threads.
     struct Unit {
         std::uint32_t task;
-        std::size_t begin, end;
+        std::size_t begin, end;  // cells
     };
     std::vector<Unit> units;
-    for (std::size_t t = 0; t < tasks.size(); ++t)
-        for (std::size_t b = 0; b < tasks[t].refs.size(); b += kSweepChunk)
-            units.push_back({static_cast<std::uint32_t>(t), b, std::min(tasks[t].refs.size(), b + kSweepChunk)});
+    for (std::size_t t = 0; t < tasks.size(); ++t) {
+        const Task& task = tasks[t];
+        const std::size_t cells = task.cell_begin.size() - 1;
+        std::size_t from = 0;
+        for (std::size_t c = 0; c < cells; ++c) {
+            if (task.cell_begin[c + 1] - task.cell_begin[from] >= kSweepChunk || c + 1 == cells) {
+                units.push_back({static_cast<std::uint32_t>(t), from, c + 1});
+                from = c + 1;
+            }
+        }
+    }
 
     const PairTester tester(objects, sets);
     std::vector<UnitOut> out(units.size());
     parallel_chunks(options.threads, units.size(), [&](std::size_t u) {
-        const Task& task = tasks[units[u].task];
+        Task& task = tasks[units[u].task];  // the unit owns its cells' refs
         UnitOut& o = out[u];
         const auto visit = [&](const SweepRef& a, const SweepRef& b) {
             if (a.part != kWholeSet && b.part != kWholeSet) {  // two triangles, boxes overlapping
@@ -284,7 +490,10 @@ ExactStageResult sweep_exact_stage(std::span<const ExactObject> objects, std::sp
             if (tester.test_sets(a.set, b.set, false, o) != 0 && options.count_set_pairs)
                 o.set_pairs.push_back(set_pair_key(a.set, b.set));
         };
-        sweep_overlaps(task.refs, task.axis, units[u].begin, units[u].end, task.self, visit);
+        for (std::size_t c = units[u].begin; c < units[u].end; ++c) {
+            sort_cell(task, c);
+            sweep_cell(task, c, visit);
+        }
     });
     ExactStageResult r = merge(out, options.count_set_pairs);
     r.stats.task_triangles = builder.task_triangles();

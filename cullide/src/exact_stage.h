@@ -8,8 +8,8 @@
 // is tested exactly (tri_tri.h) when its two boxes overlap and, inside one object, when the two
 // triangles share no welded vertex (adjacent: counted, never tested).
 //
-// Deterministic: work is cut into units fixed by the input (kSweepChunk refs of a task's sorted
-// list, kPairChunk listed pairs), units run on up to `threads` workers (cullide/src/parallel.h), and
+// Deterministic: work is cut into units fixed by the input (runs of a task's grid cells holding
+// about kSweepChunk refs, kPairChunk listed pairs), units run on up to `threads` workers (cullide/src/parallel.h), and
 // the outputs are merged in unit order and sorted on unique keys. This is the place to make the
 // exact stage fast; callers only say which sets may meet.
 #pragma once
@@ -117,7 +117,9 @@ struct SweepOptions {
 
 // Every triangle pair of overlapping boxes from sets of two objects whose boxes overlap (and of one
 // object with `self`). One task per such pair of objects holds the sets meeting the two boxes'
-// intersection (no pair outside it can meet) and is swept on its own; it sweeps the triangles
+// intersection (no pair outside it can meet) and is swept on its own, in a grid of cells over the
+// two axes other than the sweep axis (each overlapping pair visited once, in the cell holding the
+// low corner of the two boxes' intersection); it sweeps the triangles
 // instead of the sets when the sets are loose (their boxes' summed extent along the axis is more
 // than 4 times their triangles': consecutive triangles of a scrambled or thinned mesh lie far apart,
 // and a set sweep would meet more overlaps than a triangle sweep). The pairs tested are the same
