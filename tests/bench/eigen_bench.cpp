@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_frames.h"
 #include "cullide/eigen.h"
 #include "cullide/scenes.h"
 
@@ -22,19 +23,8 @@ using cullide::Mesh;
 using RowV = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 using ColV = Eigen::MatrixXd;
 
-const std::vector<Mesh>& frame_of(const std::string& scene) {
-    static std::map<std::string, std::vector<Mesh>> cache;
-    auto it = cache.find(scene);
-    if (it != cache.end()) return it->second;
-    cullide::SceneOptions options;
-    options.mesh_dir = CULLIDE_SHARED_MESH_DIR;
-    auto g = cullide::make_scene(scene, options);
-    if (!g) {
-        std::fprintf(stderr, "%s\n", g.error().message.c_str());
-        std::exit(1);
-    }
-    return cache.emplace(scene, g.value()->frame(3)).first->second;
-}
+// The benchmarked frame of every scene.
+const std::vector<Mesh>& frame_of(const std::string& scene) { return cullide_bench::scene_frame(scene, 3); }
 
 template <class VMatrix>
 struct Matrices {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_frames.h"
 #include "cullide/ground_truth.h"
 #include "cullide/scenes.h"
 #include "cullide/tri_tri.h"
@@ -51,20 +52,7 @@ std::vector<TrianglePair> all_pairs_twin(const std::vector<Mesh>& objects) {
     return out;
 }
 
-const std::vector<Mesh>& frame_of(const std::string& scene, int f) {
-    static std::map<std::pair<std::string, int>, std::vector<Mesh>> cache;
-    auto key = std::make_pair(scene, f);
-    auto it = cache.find(key);
-    if (it != cache.end()) return it->second;
-    cullide::SceneOptions options;
-    options.mesh_dir = CULLIDE_SHARED_MESH_DIR;
-    auto g = cullide::make_scene(scene, options);
-    if (!g) {
-        std::fprintf(stderr, "%s\n", g.error().message.c_str());
-        std::exit(1);
-    }
-    return cache.emplace(key, g.value()->frame(f)).first->second;
-}
+using cullide_bench::scene_frame;
 
 void check_agreement(benchmark::State& state, const std::vector<Mesh>& objects) {
     auto fast = cullide::exact_pairs(objects, {false, 1});
@@ -73,7 +61,7 @@ void check_agreement(benchmark::State& state, const std::vector<Mesh>& objects) 
 }
 
 void BM_GroundTruth(benchmark::State& state, const std::string& scene) {
-    const auto& objects = frame_of(scene, 3);
+    const auto& objects = scene_frame(scene, 3);
     check_agreement(state, objects);
     const int threads = static_cast<int>(state.range(0));
     for (auto _ : state) {
@@ -83,7 +71,7 @@ void BM_GroundTruth(benchmark::State& state, const std::string& scene) {
 }
 
 void BM_AllPairsTwin(benchmark::State& state, const std::string& scene) {
-    const auto& objects = frame_of(scene, 3);
+    const auto& objects = scene_frame(scene, 3);
     check_agreement(state, objects);
     for (auto _ : state) {
         auto r = all_pairs_twin(objects);
