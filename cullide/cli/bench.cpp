@@ -486,7 +486,7 @@ std::uint64_t pairs_digest(std::span<const TrianglePair> pairs) {
 bool never_misses(Method m) {
     // By name, so methods added to pipeline.h later default to "may miss" until listed here.
     const std::string_view n = to_string(m);
-    return n == "exact" || n == "rcullide" || n == "rcullide-offset" || n == "qcullide";
+    return n == "exact" || n == "rcullide" || n == "rcullide-offset" || n == "qcullide" || n == "auto";
 }
 
 int bench_command(const std::vector<std::string>& args, std::ostream& out, std::ostream& err,

@@ -165,7 +165,15 @@ int run_command(const std::vector<std::string>& args, std::ostream& out, std::os
                 << ", \"pcs_boxes\": " << s.pcs_boxes << ", \"pcs_objects\": " << s.pcs_objects
                 << ", \"subobjects\": " << s.subobjects << ", \"pcs_subobjects\": " << s.pcs_subobjects
                 << ", \"subobject_pairs\": " << s.subobject_pairs << ", \"queries\": " << s.queries
-                << ", \"triangles_rasterized\": " << s.triangles_rasterized << ", \"views\": [";
+                << ", \"triangles_rasterized\": " << s.triangles_rasterized;
+            if (r.options.method == Method::Auto) {
+                const AutoPlan& ap = s.auto_plan;
+                out << ", \"auto\": {\"views\": " << (ap.views ? "true" : "false")
+                    << ", \"task_triangles\": " << static_cast<std::uint64_t>(ap.task_triangles)
+                    << ", \"paired_triangles\": " << ap.paired_triangles << ", \"object_pairs\": " << ap.object_pairs
+                    << "}";
+            }
+            out << ", \"views\": [";
             for (std::size_t v = 0; v < s.views.size(); ++v) {
                 const ViewStats& vs = s.views[v];
                 out << (v ? ", " : "") << "{\"stage\": \"" << to_string(vs.stage) << "\", \"axis\": \""

@@ -98,7 +98,7 @@ ObjectStage object_stage_value(const OptionSpec& spec, const std::string& v) {
 }
 
 std::string resolution_default() {
-    return std::to_string(default_resolution(Method::RCullide)) + " for rcullide and qcullide (exact bounds), " +
+    return std::to_string(default_resolution(Method::RCullide)) + " for auto, rcullide and qcullide (exact bounds), " +
            std::to_string(default_resolution(Method::Cullide)) + " for the others";
 }
 
@@ -194,7 +194,8 @@ void add_run_options(std::vector<OptionSpec>& t) {
          "rcullide (R-CULLIDE, exact-bounds conservative raster: never misses), exact (the ground truth), "
          "cullide (GL-exact visibility culling, may miss collisions like the GPU original), rcullide-offset "
          "(R-CULLIDE with the paper's offset solids: never misses), qcullide (Quick-CULLIDE, exact-bounds: "
-         "never misses), qcullide-gl (Quick-CULLIDE, GL-exact)",
+         "never misses), qcullide-gl (Quick-CULLIDE, GL-exact), auto (never misses: rcullide's views where a "
+         "count-based estimate says they pay, else straight to the exact test)",
          {},
          std::string(to_string(d.method)) + "; qcullide with --self",
          "",

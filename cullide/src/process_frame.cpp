@@ -2,6 +2,7 @@
 // broad phases and depth formats.
 #include "cullide/pipeline.h"
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 
@@ -44,7 +45,8 @@ constexpr std::pair<const char*, Method> kMethods[] = {{"exact", Method::Exact},
                                                        {"rcullide", Method::RCullide},
                                                        {"rcullide-offset", Method::RCullideOffset},
                                                        {"qcullide", Method::QCullide},
-                                                       {"qcullide-gl", Method::QCullideGL}};
+                                                       {"qcullide-gl", Method::QCullideGL},
+                                                       {"auto", Method::Auto}};
 constexpr std::pair<const char*, BroadPhase> kBroadPhases[] = {{"none", BroadPhase::None},
                                                                {"spatialhash", BroadPhase::SpatialHash},
                                                                {"sap", BroadPhase::SweepAndPrune},
@@ -161,7 +163,53 @@ Status run_visibility(std::span<const Mesh> objects, const std::vector<std::uint
     return Status{};
 }
 
+// The share of [lo, hi] along one axis that [ilo, ihi] (inside it) covers; 1 for a flat extent
+// (a flat box is covered along that axis by any box meeting it).
+double axis_share(double lo, double hi, double ilo, double ihi) {
+    const double extent = hi - lo;
+    if (!(extent > 0.0)) return 1.0;
+    return std::clamp((ihi - ilo) / extent, 0.0, 1.0);
+}
+
+// The share of box `b` that `i` (their intersection) covers: the product of the per-axis shares.
+double box_share(const Aabb& b, const Aabb& i) {
+    return axis_share(b.lo.x, b.hi.x, i.lo.x, i.hi.x) * axis_share(b.lo.y, b.hi.y, i.lo.y, i.hi.y) *
+           axis_share(b.lo.z, b.hi.z, i.lo.z, i.hi.z);
+}
+
 }  // namespace
+
+AutoPlan plan_auto(std::span<const Mesh> objects, std::span<const std::uint32_t> active) {
+    AutoPlan plan;
+    std::vector<Aabb> boxes(active.size());
+    std::vector<char> paired(active.size(), 0);
+    for (std::size_t k = 0; k < active.size(); ++k) {
+        boxes[k] = mesh_bounds(objects[active[k]]);
+        plan.triangles += objects[active[k]].triangles.size();
+    }
+    // Every pair of kept objects, as the exact stage's task builder does (a few thousand objects at
+    // most in practice; the box test is a handful of compares).
+    for (std::size_t a = 0; a < active.size(); ++a) {
+        if (boxes[a].empty()) continue;
+        const double na = static_cast<double>(objects[active[a]].triangles.size());
+        for (std::size_t b = a + 1; b < active.size(); ++b) {
+            if (boxes[b].empty() || !overlaps(boxes[a], boxes[b])) continue;
+            const Aabb i{{std::max(boxes[a].lo.x, boxes[b].lo.x), std::max(boxes[a].lo.y, boxes[b].lo.y),
+                          std::max(boxes[a].lo.z, boxes[b].lo.z)},
+                         {std::min(boxes[a].hi.x, boxes[b].hi.x), std::min(boxes[a].hi.y, boxes[b].hi.y),
+                          std::min(boxes[a].hi.z, boxes[b].hi.z)}};
+            const double nb = static_cast<double>(objects[active[b]].triangles.size());
+            plan.task_triangles += na * box_share(boxes[a], i) + nb * box_share(boxes[b], i);
+            ++plan.object_pairs;
+            paired[a] = paired[b] = 1;
+        }
+    }
+    for (std::size_t k = 0; k < active.size(); ++k)
+        if (paired[k]) plan.paired_triangles += objects[active[k]].triangles.size();
+    plan.views = plan.paired_triangles >= kAutoMinViewTriangles &&
+                 plan.task_triangles >= kAutoViewsPay * static_cast<double>(plan.paired_triangles);
+    return plan;
+}
 
 const char* to_string(Method m) { return name_of(m, kMethods); }
 const char* to_string(BroadPhase b) { return name_of(b, kBroadPhases); }
@@ -183,6 +231,7 @@ int default_resolution(Method m) {
     switch (m) {
         case Method::RCullide:
         case Method::QCullide:
+        case Method::Auto:
             return default_resolution(VisibilityMode::ExactBounds);
         case Method::Exact:
         case Method::Cullide:
@@ -203,7 +252,7 @@ Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOption
     if (!context.state_) context.state_ = std::make_unique<FrameContext::State>();
     if (options.threads < 0) return Error{"threads must be >= 0 (got " + std::to_string(options.threads) + ")"};
     if (options.self && options.method != Method::Exact && options.method != Method::QCullide &&
-        options.method != Method::QCullideGL)
+        options.method != Method::QCullideGL && options.method != Method::Auto)
         return Error{std::string("self-collision is not supported by method '") + to_string(options.method) +
                      "' (CULLIDE never tests an object against itself); use method 'qcullide', 'qcullide-gl' "
                      "or 'exact'"};
@@ -226,6 +275,11 @@ Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOption
     st.broadphase_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - bp_start).count();
 
+    if (run.method == Method::Auto) {
+        // Self-collision runs as exact: R-CULLIDE never tests an object against itself.
+        if (!run.self) st.auto_plan = plan_auto(objects, active.value());
+        run.method = st.auto_plan.views ? Method::RCullide : Method::Exact;
+    }
     Status ran = run.method == Method::Exact
                      ? run_exact(objects, active.value(), run, result)
                      : run_visibility(objects, active.value(), run, *context.state_, result);

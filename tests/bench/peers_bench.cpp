@@ -304,7 +304,8 @@ int main(int argc, char** argv) {
                 const double frame_ms = r.ours ? median(r.total) : std::min(build + query, refit + qr);
                 const bool exact = r.misses == 0 && r.extra == 0 && r.refit_misses == 0 && r.refit_extra == 0;
                 if (!exact && (r.peer == "exact" || r.peer.rfind("rcullide@", 0) == 0 ||
-                               r.peer.rfind("rcullide-offset@", 0) == 0 || r.peer.rfind("qcullide@", 0) == 0)) {
+                               r.peer.rfind("rcullide-offset@", 0) == 0 || r.peer.rfind("qcullide@", 0) == 0 ||
+                               r.peer.rfind("auto@", 0) == 0)) {
                     status = 1;  // a method that never misses did
                 }
                 std::ostringstream label;

@@ -55,7 +55,8 @@ void bm_tiny(benchmark::State& state, cullide::Method method, bool reuse) {
 }
 
 void register_all() {
-    for (const cullide::Method m : {cullide::Method::Exact, cullide::Method::RCullide, cullide::Method::QCullide,
+    for (const cullide::Method m : {cullide::Method::Auto, cullide::Method::Exact, cullide::Method::RCullide,
+                                    cullide::Method::QCullide,
                                     cullide::Method::Cullide, cullide::Method::RCullideOffset,
                                     cullide::Method::QCullideGL}) {
         for (const bool reuse : {false, true}) {

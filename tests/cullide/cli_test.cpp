@@ -200,7 +200,7 @@ TEST_CASE("bad visibility options are usage errors naming the option and the val
     CHECK(o.status == 2);
     CHECK(has(o.err, "--object-stage must be auto, on or off (got 'maybe')"));
     o = run({"run", "--method", "magic"});
-    CHECK(has(o.err, "(valid: exact, cullide, rcullide, rcullide-offset, qcullide, qcullide-gl)"));
+    CHECK(has(o.err, "(valid: exact, cullide, rcullide, rcullide-offset, qcullide, qcullide-gl, auto)"));
     o = run({"run", "--method", "cullide", "--self", "--scale", "0.05", "--frames", "1"});
     CHECK(o.status == 1);
     CHECK(has(o.err, "self-collision is not supported by method 'cullide'"));

@@ -84,7 +84,7 @@ TEST_CASE("the reliable methods report exactly the ground-truth pairs on every b
             const auto exact = truth(objects);
             total_pairs += exact.size();
             for (int resolution : {128}) {
-                for (Method m : {Method::RCullide, Method::RCullideOffset}) {
+                for (Method m : {Method::RCullide, Method::RCullideOffset, Method::Auto}) {
                     CAPTURE(name);
                     CAPTURE(frame);
                     CAPTURE(resolution);
@@ -386,4 +386,120 @@ TEST_CASE("resolution 0 means each method's own default resolution") {
     // methods high).
     CHECK(cullide::default_resolution(Method::RCullide) < cullide::default_resolution(Method::Cullide));
     CHECK(cullide::default_resolution(Method::QCullide) < cullide::default_resolution(Method::QCullideGL));
+}
+
+namespace {
+
+// An axis-aligned box [lo, hi] as 12 triangles.
+cullide::Mesh box_mesh(cullide::Vec3 lo, cullide::Vec3 hi, std::string name) {
+    cullide::Mesh m;
+    m.name = std::move(name);
+    for (int c = 0; c < 8; ++c)
+        m.positions.push_back({(c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z});
+    m.triangles = {{0, 4, 6}, {0, 6, 2}, {1, 3, 7}, {1, 7, 5}, {0, 1, 5}, {0, 5, 4},
+                   {2, 6, 7}, {2, 7, 3}, {0, 2, 3}, {0, 3, 1}, {4, 5, 7}, {4, 7, 6}};
+    return m;
+}
+
+// A UV sphere of `rings` x `segments` quads (two triangles each, poles included as thin quads).
+cullide::Mesh sphere(cullide::Vec3 c, double r, int rings, int segments, std::string name) {
+    cullide::Mesh m;
+    m.name = std::move(name);
+    const double pi = std::acos(-1.0);
+    for (int i = 0; i <= rings; ++i) {
+        const double th = pi * (i + 0.5) / (rings + 1);
+        for (int j = 0; j < segments; ++j) {
+            const double ph = 2 * pi * j / segments + 0.1 * i;
+            m.positions.push_back({c.x + r * std::sin(th) * std::cos(ph), c.y + r * std::sin(th) * std::sin(ph),
+                                   c.z + r * std::cos(th)});
+        }
+    }
+    const auto at = [&](int i, int j) { return static_cast<std::uint32_t>(i * segments + (j % segments)); };
+    for (int i = 0; i < rings; ++i)
+        for (int j = 0; j < segments; ++j) {
+            m.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+            m.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+        }
+    return m;
+}
+
+// A heap of spheres whose boxes all overlap each other: each triangle sits in many object-pair
+// tasks of the exact stage, the case where auto runs R-CULLIDE's views.
+std::vector<cullide::Mesh> sphere_heap() {
+    std::vector<cullide::Mesh> heap;
+    for (int k = 0; k < 10; ++k)
+        heap.push_back(sphere({0.13 * (k % 3), 0.11 * (k % 4), 0.07 * k}, 1.0 + 0.031 * k, 16, 24,
+                              "s" + std::to_string(k)));
+    return heap;
+}
+
+}  // namespace
+
+TEST_CASE("auto: the plan counts the exact stage's task triangles from the object boxes") {
+    // Two 12-triangle boxes overlapping over half of each along x: 6 + 6 task triangles.
+    const std::vector<cullide::Mesh> two = {box_mesh({0, 0, 0}, {2, 2, 2}, "a"), box_mesh({1, 0, 0}, {3, 2, 2}, "b"),
+                                            box_mesh({10, 10, 10}, {11, 11, 11}, "far")};
+    const std::uint32_t all[] = {0, 1, 2};
+    const cullide::AutoPlan p = cullide::plan_auto(two, all);
+    CHECK(p.triangles == 36);
+    CHECK(p.paired_triangles == 24);
+    CHECK(p.object_pairs == 1);
+    CHECK(p.task_triangles == doctest::Approx(12.0));
+    CHECK_FALSE(p.views);  // far below kAutoMinViewTriangles
+    // A flat object (zero extent along z) is covered along that axis by any box meeting it; the
+    // other object's share along z is then the flat intersection's: none (an estimate).
+    const std::vector<cullide::Mesh> flat = {box_mesh({0, 0, 0}, {4, 4, 0}, "f"), box_mesh({0, 0, -1}, {1, 4, 1}, "g")};
+    const std::uint32_t both[] = {0, 1};
+    CHECK(cullide::plan_auto(flat, both).task_triangles == doctest::Approx(12 * 0.25 + 12 * 0.0));
+    // Only the listed objects count.
+    const std::uint32_t one[] = {0};
+    CHECK(cullide::plan_auto(two, one).object_pairs == 0);
+}
+
+TEST_CASE("auto: straight to the exact stage on small or loose scenes, views on a heap; always the ground truth") {
+    // Small: two crossing triangles take the exact path (no view).
+    const std::vector<cullide::Mesh> tiny = {triangle({0, 0, 0}, 1, {1, 0.1, 0.3}, {-0.5, 0.87, -0.2}, {-0.5, -0.87, 0.1}, "t1"),
+                                             triangle({0, 0, 0}, 1, {0.3, 0.9, -0.1}, {-0.2, -0.3, 0.95}, {0.1, -0.4, -0.9}, "t2")};
+    const cullide::FrameResult t = run(tiny, Method::Auto, 0);
+    CHECK_FALSE(t.stats.auto_plan.views);
+    CHECK(t.stats.views.empty());
+    CHECK(t.pairs.size() == 1);
+    CHECK(t.pairs == truth(tiny));
+
+    // A heap: every box meets every other, views pay by the estimate and run.
+    const std::vector<cullide::Mesh> heap = sphere_heap();
+    const auto exact = truth(heap);
+    REQUIRE(exact.size() > 100);  // the spheres cross each other
+    const cullide::FrameResult h1 = run(heap, Method::Auto, 0, 1);
+    const cullide::FrameResult h2 = run(heap, Method::Auto, 0, 2);
+    CHECK(h1.stats.auto_plan.views);
+    CHECK(h1.stats.auto_plan.object_pairs == 45);
+    CHECK(h1.stats.auto_plan.task_triangles >= cullide::kAutoViewsPay * h1.stats.auto_plan.paired_triangles);
+    CHECK_FALSE(h1.stats.views.empty());
+    CHECK(h1.stats.pcs_subobjects < h1.stats.subobjects);  // the views pruned something
+    CHECK(h1.pairs == exact);
+    CHECK(h2.pairs == exact);
+    CHECK(h1.stats.pcs_subobjects == h2.stats.pcs_subobjects);
+    CHECK(h1.stats.exact_tests == h2.stats.exact_tests);
+    // The same frame as rcullide gives the same PCS (auto's views are rcullide's).
+    const cullide::FrameResult r = run(heap, Method::RCullide, 0, 1);
+    CHECK(r.stats.pcs_subobjects == h1.stats.pcs_subobjects);
+    CHECK(r.stats.triangles_rasterized == h1.stats.triangles_rasterized);
+
+    // Self-collision runs as exact.
+    cullide::RunOptions so;
+    so.method = Method::Auto;
+    so.self = true;
+    auto self_auto = cullide::process_frame(tiny, so);
+    REQUIRE(self_auto.ok());
+    auto self_exact = cullide::exact_pairs(tiny, {true, 1});
+    REQUIRE(self_exact.ok());
+    CHECK(self_auto.value().pairs == self_exact.value());
+    CHECK_FALSE(self_auto.value().stats.auto_plan.views);
+}
+
+TEST_CASE("auto is the default method") {
+    CHECK(cullide::RunOptions{}.method == Method::Auto);
+    CHECK(cullide::parse_method("auto").value() == Method::Auto);
+    CHECK(cullide::default_resolution(Method::Auto) == cullide::default_resolution(Method::RCullide));
 }

@@ -210,7 +210,7 @@ TEST_CASE("self_collide equals process_frame with self on, for the self-capable 
     test::Rng rng(7);
     std::vector<Mesh> cases = {cloth.value()->frame(5)[0], soup(rng, 60, "soup")};
     for (const Mesh& m : cases) {
-        for (Method method : {Method::Exact, Method::QCullide, Method::QCullideGL}) {
+        for (Method method : {Method::Exact, Method::QCullide, Method::QCullideGL, Method::Auto}) {
             CAPTURE(m.name);
             CAPTURE(cullide::to_string(method));
             RunOptions o;
@@ -281,7 +281,8 @@ TEST_CASE("bad V or F gives an error naming the object, the mesh, the element an
           "object 1: mesh 'mesh1': vertex 2 has a non-finite coordinate");
 
     // Options are process_frame's, with its messages: self-collision needs a method that has it.
-    RunOptions rc;  // the default method, rcullide
+    RunOptions rc;
+    rc.method = cullide::Method::RCullide;
     CHECK(error_of(cullide::self_collide(v, f, rc)) ==
           "self-collision is not supported by method 'rcullide' (CULLIDE never tests an object against itself); "
           "use method 'qcullide', 'qcullide-gl' or 'exact'");

@@ -50,7 +50,7 @@ class Digest {
 // the reliability tests assert they report exactly the ground truth. The others (exact itself, and
 // the GL-exact ones: cullide, qcullide-gl) are not in this list; a new reliable method is added here.
 [[nodiscard]] inline bool reliable_method(std::string_view method) {
-    return method == "rcullide" || method == "rcullide-offset" || method == "qcullide";
+    return method == "rcullide" || method == "rcullide-offset" || method == "qcullide" || method == "auto";
 }
 
 }  // namespace reliability

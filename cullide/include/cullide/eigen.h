@@ -212,8 +212,8 @@ template <class DerivedV1, class DerivedF1, class DerivedV2, class DerivedF2>
 }
 
 // One object against itself: process_frame with options.self forced on. The method must support
-// self-collision (exact, qcullide, qcullide-gl); RunOptions' default method, rcullide, does not, and
-// process_frame's error says so.
+// self-collision (exact, qcullide, qcullide-gl, and auto, RunOptions' default, which runs exact
+// then); the CULLIDE methods do not, and process_frame's error says so.
 template <class DerivedV, class DerivedF>
 [[nodiscard]] Result<CollideResult> self_collide(const Eigen::MatrixBase<DerivedV>& V, const Eigen::MatrixBase<DerivedF>& F,
                                                  RunOptions options) {

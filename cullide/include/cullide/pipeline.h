@@ -29,7 +29,38 @@ enum class Method {
     RCullideOffset,  // R-CULLIDE with the paper's offset solids, pixel-centre GL (never misses; any device)
     QCullide,        // Quick-CULLIDE, exact-bounds mode (never misses; emulator only; self-collision)
     QCullideGL,      // Quick-CULLIDE, GL-exact mode (may miss; any device; self-collision)
+    // The adaptive never-miss method, the default: per frame, a deterministic estimate from counts
+    // (triangles, object boxes and their overlaps; never a clock) decides whether R-CULLIDE's views
+    // can prune more exact-stage work than they cost; if so the frame runs as RCullide, otherwise
+    // straight to the exact stage (as Exact). Either way its pairs are the ground truth's. With
+    // self-collision it runs as Exact. The rule and its figures: docs/cullide.md, "The default: auto".
+    Auto,
 };
+
+// Method::Auto's estimate for one frame (plan_auto): the exact stage's work, counted as the
+// triangles its object-pair tasks would hold (each object's triangles times the share of its box
+// that the pair's common box covers, per axis, summed over the overlapping object pairs), against
+// the triangles a round of three R-CULLIDE views would rasterize. Deterministic: counts and box
+// extents only, so the choice is the same for any thread count and machine.
+struct AutoPlan {
+    std::uint64_t triangles = 0;         // triangles of the kept objects
+    std::uint64_t paired_triangles = 0;  // of those, in objects whose box overlaps another's
+    std::uint64_t object_pairs = 0;      // overlapping object-box pairs
+    double task_triangles = 0;           // estimated triangles of the exact stage's tasks
+    bool views = false;                  // run R-CULLIDE's views (else straight to the exact stage)
+};
+
+// Views pay when the estimated task triangles reach this many times the paired triangles
+// (docs/cullide.md, "The default: auto": a 32 px view costs about as much per triangle as the exact
+// stage per task triangle, and a frame of R-CULLIDE runs at least three views).
+inline constexpr double kAutoViewsPay = 4.0;
+// Below this many paired triangles a frame always goes straight to the exact stage: set-up
+// (views fitted, buffers cleared) outweighs any pruning (docs/cullide.md, "Tiny frames").
+inline constexpr std::uint64_t kAutoMinViewTriangles = 4096;
+
+// The plan Method::Auto follows for `objects` restricted to `active` (strictly increasing indices
+// into `objects`; the broad phase's survivors). Meshes must be valid (validate_scene).
+[[nodiscard]] AutoPlan plan_auto(std::span<const Mesh> objects, std::span<const std::uint32_t> active);
 
 // The optional first stage, on the objects' axis-aligned boxes (spatialhash/broad_phase.h).
 enum class BroadPhase { None, SpatialHash, SweepAndPrune, BruteForce };
@@ -48,7 +79,7 @@ enum class BroadPhase { None, SpatialHash, SweepAndPrune, BruteForce };
 [[nodiscard]] std::vector<std::string> method_names();
 
 // The method's default view resolution: default_resolution of its VisibilityMode (visibility.h),
-// 32 for rcullide and qcullide, 1024 for the others.
+// 32 for rcullide, qcullide and auto (its views are rcullide's), 1024 for the others.
 [[nodiscard]] int default_resolution(Method m);
 
 // A run: the visibility methods' shared options (visibility.h: resolution, 0 = the method's
@@ -56,10 +87,11 @@ enum class BroadPhase { None, SpatialHash, SweepAndPrune, BruteForce };
 // phase, the exact method and the emulator) and the run's own. process_frame hands the shared part
 // to the method as it is.
 struct RunOptions : VisibilityOptions {
-    Method method = Method::RCullide;  // R-CULLIDE (exact-bounds): never misses, ends in the exact test
+    Method method = Method::Auto;  // adaptive: R-CULLIDE's views where they pay, else the exact stage;
+                                   // never misses
     bool self = false;        // also report pairs inside one object (adjacent triangles excluded);
-                              // exact, qcullide and qcullide-gl only (CULLIDE never tests an object
-                              // against itself)
+                              // exact, qcullide, qcullide-gl and auto (as exact) only (CULLIDE
+                              // never tests an object against itself)
     double min_prune = -1.0;      // CullideOptions::min_prune (cullide, rcullide, rcullide-offset)
     ObjectStage object_stage = ObjectStage::Auto;  // CullideOptions::object_stage (same methods)
     BroadPhase broadphase = BroadPhase::None;  // with self on, no object is dropped by it
@@ -83,6 +115,8 @@ struct FrameStats : VisibilityStats {
     // Pieces paired for the exact stage: CULLIDE's sub-object pairs holding a tested triangle pair
     // (CullideStats::subobject_pairs), Quick-CULLIDE's kept item pairs (QuickStats::item_pairs_kept).
     std::uint64_t subobject_pairs = 0;
+    // Method::Auto: its plan for this frame (default-constructed for the other methods).
+    AutoPlan auto_plan;
 };
 
 struct FrameResult {
