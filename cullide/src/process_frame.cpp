@@ -177,6 +177,19 @@ double box_share(const Aabb& b, const Aabb& i) {
            axis_share(b.lo.z, b.hi.z, i.lo.z, i.hi.z);
 }
 
+// The box of a mesh's vertex list (referenced or not): one linear pass over the positions, where
+// mesh_bounds follows the triangles' indices (three scattered reads per triangle). For the estimate
+// only; the exact stage keeps its own boxes.
+Aabb vertex_bounds(const Mesh& m) {
+    if (m.positions.empty()) return Aabb{};
+    Vec3 lo = m.positions[0], hi = m.positions[0];
+    for (const Vec3& p : m.positions) {
+        lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+        hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    }
+    return {lo, hi};
+}
+
 }  // namespace
 
 AutoPlan plan_auto(std::span<const Mesh> objects, std::span<const std::uint32_t> active) {
@@ -184,8 +197,9 @@ AutoPlan plan_auto(std::span<const Mesh> objects, std::span<const std::uint32_t>
     std::vector<Aabb> boxes(active.size());
     std::vector<char> paired(active.size(), 0);
     for (std::size_t k = 0; k < active.size(); ++k) {
-        boxes[k] = mesh_bounds(objects[active[k]]);
-        plan.triangles += objects[active[k]].triangles.size();
+        const Mesh& m = objects[active[k]];
+        boxes[k] = m.triangles.empty() ? Aabb{} : vertex_bounds(m);
+        plan.triangles += m.triangles.size();
     }
     // Every pair of kept objects, as the exact stage's task builder does (a few thousand objects at
     // most in practice; the box test is a handful of compares).

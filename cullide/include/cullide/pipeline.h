@@ -39,7 +39,8 @@ enum class Method {
 
 // Method::Auto's estimate for one frame (plan_auto): the exact stage's work, counted as the
 // triangles its object-pair tasks would hold (each object's triangles times the share of its box
-// that the pair's common box covers, per axis, summed over the overlapping object pairs), against
+// that the pair's common box covers, per axis, summed over the overlapping object pairs; boxes of
+// the vertex lists, read in one linear pass), against
 // the triangles a round of three R-CULLIDE views would rasterize. Deterministic: counts and box
 // extents only, so the choice is the same for any thread count and machine.
 struct AutoPlan {
