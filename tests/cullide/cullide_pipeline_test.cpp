@@ -427,7 +427,7 @@ cullide::Mesh sphere(cullide::Vec3 c, double r, int rings, int segments, std::st
 // tasks of the exact stage, the case where auto runs R-CULLIDE's views.
 std::vector<cullide::Mesh> sphere_heap() {
     std::vector<cullide::Mesh> heap;
-    for (int k = 0; k < 10; ++k)
+    for (int k = 0; k < 20; ++k)
         heap.push_back(sphere({0.13 * (k % 3), 0.11 * (k % 4), 0.07 * k}, 1.0 + 0.031 * k, 16, 24,
                               "s" + std::to_string(k)));
     return heap;
@@ -473,7 +473,7 @@ TEST_CASE("auto: straight to the exact stage on small or loose scenes, views on 
     const cullide::FrameResult h1 = run(heap, Method::Auto, 0, 1);
     const cullide::FrameResult h2 = run(heap, Method::Auto, 0, 2);
     CHECK(h1.stats.auto_plan.views);
-    CHECK(h1.stats.auto_plan.object_pairs == 45);
+    CHECK(h1.stats.auto_plan.object_pairs == 190);
     CHECK(h1.stats.auto_plan.task_triangles >= cullide::kAutoViewsPay * h1.stats.auto_plan.paired_triangles);
     CHECK_FALSE(h1.stats.views.empty());
     CHECK(h1.stats.pcs_subobjects < h1.stats.subobjects);  // the views pruned something

@@ -51,10 +51,11 @@ struct AutoPlan {
     bool views = false;                  // run R-CULLIDE's views (else straight to the exact stage)
 };
 
-// Views pay when the estimated task triangles reach this many times the paired triangles
+// Views run when the estimated task triangles reach this many times the paired triangles
 // (docs/cullide.md, "The default: auto": a 32 px view costs about as much per triangle as the exact
-// stage per task triangle, and a frame of R-CULLIDE runs at least three views).
-inline constexpr double kAutoViewsPay = 4.0;
+// stage per task triangle, a frame of R-CULLIDE runs at least six views, and on heaps of spheres
+// the views only broke even at a ratio of 7 and won at 13).
+inline constexpr double kAutoViewsPay = 8.0;
 // Below this many paired triangles a frame always goes straight to the exact stage: set-up
 // (views fitted, buffers cleared) outweighs any pruning (docs/cullide.md, "Tiny frames").
 inline constexpr std::uint64_t kAutoMinViewTriangles = 4096;
