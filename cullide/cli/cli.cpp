@@ -196,7 +196,14 @@ int run_command(const std::vector<std::string>& args, std::ostream& out, std::os
                     << s.broadphase_pairs << " box pairs, " << std::fixed << std::setprecision(2) << s.broadphase_ms
                     << " ms" << std::defaultfloat << "\n";
             }
-            if (visibility) {
+            const bool is_auto = r.options.method == Method::Auto;
+            if (is_auto) {
+                const AutoPlan& ap = s.auto_plan;
+                out << "  auto: " << (ap.views ? "rcullide's views" : "straight to the exact stage") << " (estimated "
+                    << static_cast<std::uint64_t>(ap.task_triangles) << " task triangles for " << ap.paired_triangles
+                    << " paired triangles in " << ap.object_pairs << " object pairs)\n";
+            }
+            if (visibility && (!is_auto || s.auto_plan.views)) {
                 const bool object_views = std::any_of(s.views.begin(), s.views.end(),
                                                       [](const ViewStats& v) { return v.stage == CullStage::Objects; });
                 out << "  pcs: boxes " << s.broadphase_objects << " -> " << s.pcs_boxes << " objects, triangles -> "
