@@ -167,7 +167,7 @@ if [ -n "$peers" ]; then
   for s in "${scenes[@]}"; do
     step "peers-$s" "$peers" --scenes "$s" --scales "$(scene_scale "$s")" --frames "$peers_frames" \
       --first-frame "$(first_frame "$s")" --frame-step 5 --reps 3 --threads "$threads" \
-      --methods exact,cullide,rcullide,rcullide-offset --mesh-dir "$mesh_dir" --csv "$tmp/peers_$s.csv"
+      --methods exact,auto,cullide,rcullide,rcullide-offset --mesh-dir "$mesh_dir" --csv "$tmp/peers_$s.csv"
     parts+=("$tmp/peers_$s.csv")
   done
   concat "$data/peers.csv" "${parts[@]}"
