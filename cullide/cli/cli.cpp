@@ -47,11 +47,12 @@ struct RunArgs {
     SceneOptions scene_options;
 };
 
-// run's own defaults, after the table's: --self without --method runs qcullide, and a method without
-// --resolution runs at its default_resolution (printed, so the text and JSON show the real figure).
+// run's own defaults, after the table's: a method without --resolution runs at its
+// default_resolution (printed, so the text and JSON show the real figure). --self without --method
+// runs the default, auto, which runs exact then (it used to run qcullide, measured slower than exact
+// with self-collision: docs/quick-cullide.md).
 RunArgs run_args_of(const Settings& s) {
     RunOptions p = s.pipeline;
-    if (p.self && !s.method_given) p.method = Method::QCullide;
     if (p.resolution == 0) p.resolution = default_resolution(p.method);
     return RunArgs{s.inputs, p, s.frames, s.pairs_file, s.json, s.scene};
 }

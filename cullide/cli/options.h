@@ -41,7 +41,6 @@ struct Settings {
     // Bench and sweep cross the method, resolution, depth format and thread count with their
     // lists, per combination.
     RunOptions pipeline;
-    bool method_given = false;  // run: --self without --method runs qcullide
     SceneOptions scene;
     bool help = false;  // --help / -h anywhere: print the command's help and nothing else
     std::optional<int> frames;

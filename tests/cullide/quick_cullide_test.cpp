@@ -367,7 +367,7 @@ TEST_CASE("bad options are refused with a message naming them") {
     CHECK(f.error().message.find("use method 'qcullide'") != std::string::npos);
 }
 
-TEST_CASE("CLI: --self defaults to qcullide, the new methods run, and CULLIDE methods refuse --self") {
+TEST_CASE("CLI: --self defaults to auto, the new methods run, and CULLIDE methods refuse --self") {
     auto cli = [](std::vector<std::string> args, std::string& out, std::string& err) {
         std::ostringstream o, e;
         const int status = cullide::cli::run(args, o, e);
@@ -383,7 +383,8 @@ TEST_CASE("CLI: --self defaults to qcullide, the new methods run, and CULLIDE me
         return cli(a, out, err);
     };
     REQUIRE(with({"--self"}) == 0);
-    CHECK(out.find("method qcullide, self-collision on") != std::string::npos);
+    CHECK(out.find("method auto, self-collision on") != std::string::npos);
+    CHECK(out.find("auto: straight to the exact stage") != std::string::npos);
     REQUIRE(with({"--self", "--method", "qcullide-gl", "--json"}) == 0);
     CHECK(out.find("\"method\": \"qcullide-gl\", \"self\": true") != std::string::npos);
     REQUIRE(with({"--method", "qcullide", "--subobject", "1", "--broadphase", "sap"}) == 0);
