@@ -33,6 +33,10 @@ TEST_CASE("every built-in scene at full scale: reliable modes exact, cullide's m
         REQUIRE(scene.ok());
         const cullide::Frame objects = scene.value()->frame(2);
         const auto exact = truth(objects);
+        {
+            CAPTURE(name);
+            CHECK(run(objects, Method::Auto, 0).pairs == exact);  // the default, at the papers' sizes
+        }
         for (int resolution : {256, 1024}) {
             CAPTURE(name);
             CAPTURE(resolution);
