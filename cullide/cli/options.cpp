@@ -199,7 +199,9 @@ void add_run_options(std::vector<OptionSpec>& t) {
          {},
          std::string(to_string(d.method)) + "; with --self it runs exact",
          "",
-         [](const OptionSpec& o, const std::string& v, Settings& s) { s.pipeline.method = checked(o, parse_method(v)); }});
+         [](const OptionSpec& o, const std::string& v, Settings& s) {
+             s.pipeline.method = checked(o, parse_method(v));
+         }});
     t.push_back({"--frames", "N", kRunOnly, "frames to run", integers(1, 1000000),
                  "10 for built-in scenes, 1 for files", "",
                  [](const OptionSpec& o, const std::string& v, Settings& s) { s.frames = int_value(o, v); }});

@@ -458,8 +458,9 @@ TEST_CASE("auto: the plan counts the exact stage's task triangles from the objec
 
 TEST_CASE("auto: straight to the exact stage on small or loose scenes, views on a heap; always the ground truth") {
     // Small: two crossing triangles take the exact path (no view).
-    const std::vector<cullide::Mesh> tiny = {triangle({0, 0, 0}, 1, {1, 0.1, 0.3}, {-0.5, 0.87, -0.2}, {-0.5, -0.87, 0.1}, "t1"),
-                                             triangle({0, 0, 0}, 1, {0.3, 0.9, -0.1}, {-0.2, -0.3, 0.95}, {0.1, -0.4, -0.9}, "t2")};
+    const std::vector<cullide::Mesh> tiny = {
+        triangle({0, 0, 0}, 1, {1, 0.1, 0.3}, {-0.5, 0.87, -0.2}, {-0.5, -0.87, 0.1}, "t1"),
+        triangle({0, 0, 0}, 1, {0.3, 0.9, -0.1}, {-0.2, -0.3, 0.95}, {0.1, -0.4, -0.9}, "t2")};
     const cullide::FrameResult t = run(tiny, Method::Auto, 0);
     CHECK_FALSE(t.stats.auto_plan.views);
     CHECK(t.stats.views.empty());
