@@ -15,6 +15,7 @@
 #include <set>
 
 #include "cullide/predicates.h"
+#include "cullide/tri_tri.h"
 #include "cullide/visibility.h"
 
 namespace cullide::hunt {
@@ -213,12 +214,13 @@ Frame sub_pixel(Rng& r) {
     const int u = (axis + 1) % 3, v = (axis + 2) % 3;
     const double c = r.range(-0.3, 0.3);
     f.push_back(wall("sheet", axis, c, -0.8, 0.8, r.between(1, 3)));
-    // Tilt the sheet now and then, so the contact is not axis-aligned.
-    if (r.coin(40)) {
-        const double tilt = r.range(-0.3, 0.3);
-        for (Vec3& p : f.back().positions) p[axis] = p[axis] + tilt * p[u];
+    // Tilt the sheet now and then, in both directions, so that no axis view sees it edge-on.
+    double tu = 0, tv = 0;
+    if (r.coin(60)) {
+        tu = r.range(-0.4, 0.4);
+        tv = r.range(-0.4, 0.4);
+        for (Vec3& p : f.back().positions) p[axis] = c + tu * p[u] + tv * p[v];
     }
-    const Mesh sheet = f.back();
     const int pokes = r.between(1, 3);
     for (int o = 0; o < pokes; ++o) {
         const double depth = std::ldexp(1.0, -r.between(7, 24));
@@ -226,10 +228,8 @@ Frame sub_pixel(Rng& r) {
         Vec3 tip;
         tip[u] = r.range(-0.6, 0.6);
         tip[v] = r.range(-0.6, 0.6);
-        // The sheet's height under the tip (the tilt is linear in u), then a little past it.
-        const double tilt_h = sheet.positions[1][axis] - sheet.positions[0][axis];
-        const double du = sheet.positions[1][u] - sheet.positions[0][u];
-        tip[axis] = sheet.positions[0][axis] + (tip[u] - sheet.positions[0][u]) * (tilt_h / du) - side * depth;
+        // The sheet's height under the tip (rounding errors are far below `depth`), then past it.
+        tip[axis] = c + tu * tip[u] + tv * tip[v] - side * depth;
         Vec3 b = tip, c2 = tip, d = tip;
         const double h = r.range(0.05, 0.5);
         b[axis] += side * h;
@@ -696,6 +696,7 @@ const char* to_string(Reason r) {
         case Reason::PixelTie: return "pixel-tie";
         case Reason::SubPixel: return "sub-pixel";
         case Reason::EdgeOn: return "edge-on";
+        case Reason::Touching: return "touching";
         case Reason::Unclassified: return "unclassified";
     }
     return "?";
@@ -737,13 +738,22 @@ Result<Reason> classify(std::span<const Mesh> objects, const Verdict& verdict, c
         if (!c) return c.error();
         if (c.value()) return Reason::SubPixel;
     }
+    const bool all_touching = std::all_of(verdict.missed.begin(), verdict.missed.end(), [&](const TrianglePair& p) {
+        const Mesh &a = objects[p.object_a], &b = objects[p.object_b];
+        const Tri &ta = a.triangles[p.triangle_a], &tb = b.triangles[p.triangle_b];
+        const TriRelation rel = tri_tri_relation(a.positions[ta[0]], a.positions[ta[1]], a.positions[ta[2]],
+                                                 b.positions[tb[0]], b.positions[tb[1]], b.positions[tb[2]]);
+        return rel == TriRelation::Touching || rel == TriRelation::CoplanarOverlap;
+    });
+    if (all_touching) return Reason::Touching;
     const bool all_edge_on = std::all_of(verdict.missed.begin(), verdict.missed.end(), [&](const TrianglePair& p) {
         for (int axis = 0; axis < 3; ++axis)
             if (edge_on(objects[p.object_a], p.triangle_a, axis) || edge_on(objects[p.object_b], p.triangle_b, axis))
                 return true;
         return false;
     });
-    return all_edge_on ? Reason::EdgeOn : Reason::Unclassified;
+    if (all_edge_on) return Reason::EdgeOn;
+    return Reason::Unclassified;
 }
 
 }  // namespace cullide::hunt

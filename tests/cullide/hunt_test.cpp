@@ -172,6 +172,34 @@ TEST_CASE("the planted edge-on miss is shrunk to a smaller frame that still miss
     CHECK(cullide::frame_digest(same) == cullide::frame_digest(planted));
 }
 
+TEST_CASE("boxes touching face to face are missed at any setting, and classified touching") {
+    const auto box = [](Vec3 lo, Vec3 hi) {
+        Mesh m;
+        m.name = "box";
+        for (int i = 0; i < 8; ++i)
+            m.positions.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
+        const std::uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+        for (const auto& f : q) {
+            m.triangles.push_back({f[0], f[1], f[2]});
+            m.triangles.push_back({f[0], f[2], f[3]});
+        }
+        return m;
+    };
+    const Frame touching{box({0, 0, 0}, {1, 1, 1}), box({1, 0.25, 0.25}, {2, 0.75, 0.75})};
+    cullide::FrameContext context;
+    const RunOptions opt = gl_exact_cullide();
+    const hunt::Verdict v = hunt::check(touching, opt, context).value();
+    REQUIRE_FALSE(v.missed.empty());
+    CHECK(hunt::classify(touching, v, opt, context).value() == hunt::Reason::Touching);
+    // "No setting helps": D32F, a finer view and a shifted grid all still miss.
+    for (int resolution : {65, 256}) {
+        RunOptions o = opt;
+        o.resolution = resolution;
+        o.depth_format = raster::DepthFormat::D32F;
+        CHECK(hunt::check(touching, o, context).value().failed());
+    }
+}
+
 TEST_CASE("classify names a depth-quantization miss and a sub-pixel miss by re-running") {
     // Two triangles crossing by a sliver: with D16 over a deep scene the crossing is lost in depth
     // quantization only if D32F finds it, so the test asserts only the consistency of the answer:

@@ -73,12 +73,26 @@ struct Verdict {
 // Asked between checks; true stops the search or the shrinking at once (Ctrl-C, a time budget).
 using StopFn = std::function<bool()>;
 
-enum class Reason;
+// Why a method misses, named by re-running the frame with one setting changed (first match wins):
+enum class Reason {
+    DepthQuantization,  // D16/D24 misses it, D32F at the same resolution does not
+    PixelTie,           // a view one pixel larger or smaller catches it: the contact sits on the pixel
+                        // grid (a tie at a pixel centre: an edge or an equal depth exactly there)
+    SubPixel,           // four times the resolution catches it
+    Touching,           // no setting above helps, and every missed pair only touches (tri_tri.h: Touching
+                        // or CoplanarOverlap, no crossing): the contact has no volume, so every depth
+                        // comparison on it is a tie, at any resolution and depth format
+    EdgeOn,             // no setting above helps, not Touching, and in every missed pair a triangle is
+                        // seen edge-on (zero area) in an axis view, where the rasterizer covers none of
+                        // its pixels (a property of the geometry, not proven to be the cause)
+    Unclassified,       // none of the above (also: a never-miss method's disagreement)
+};
+[[nodiscard]] const char* to_string(Reason r);
 
 struct ShrinkStats {
     std::uint64_t checks = 0;            // frames run while shrinking (a classification counts 4)
     bool stopped = false;                // the stop function or the check limit ended it early
-    Reason reason{};                     // classify's reason after the object and triangle stages
+    Reason reason = Reason::Unclassified;  // classify's reason after the object and triangle stages
 };
 
 // Shrinks a failing frame: ddmin over objects, then over all triangles (objects left without one
@@ -91,17 +105,6 @@ struct ShrinkStats {
 [[nodiscard]] Frame shrink(const Frame& failing, const RunOptions& options, FrameContext& context,
                            const StopFn& stop, std::uint64_t max_checks, ShrinkStats* stats = nullptr);
 
-// Why a method misses, named by re-running the frame with one setting changed (first match wins):
-enum class Reason : int {
-    DepthQuantization,  // D16/D24 misses it, D32F at the same resolution does not
-    PixelTie,           // a view one pixel larger or smaller catches it: the contact sits on the pixel
-                        // grid (a tie at a pixel centre: an edge or an equal depth exactly there)
-    SubPixel,           // four times the resolution catches it
-    EdgeOn,             // no setting above helps, and in every missed pair a triangle is seen edge-on
-                        // (zero area) in an axis view, where the rasterizer covers none of its pixels
-    Unclassified,       // none of the above (also: a never-miss method's disagreement)
-};
-[[nodiscard]] const char* to_string(Reason r);
 
 // The reason of `verdict` (which must come from check(objects, options)). Runs at most four frames.
 [[nodiscard]] Result<Reason> classify(std::span<const Mesh> objects, const Verdict& verdict, const RunOptions& options,
