@@ -2,12 +2,13 @@
 # The figures of docs/hunt.md: `cullide hunt` on every built-in scene at the papers' resolution
 # (GL-exact CULLIDE at 1024 x 1024, D24), and the axis-aligned room generator across methods,
 # resolutions and depth formats. Writes docs/data/hunt_scenes.csv, docs/data/hunt_room.csv and the
-# findings under $OUT (default /tmp/cullide-hunt-docs). Run from the repository root after a build:
-#   bash scripts/hunt_docs.sh [BUDGET_S_PER_SCENE]
+# findings under $OUT (default /tmp/cullide-hunt-docs). Budgets are case counts, not seconds, so the
+# counts (not the times) are the same on every machine. Run from the repository root after a build:
+#   bash scripts/hunt_docs.sh [CASES_PER_SCENE]
 set -euo pipefail
 CULLIDE=${CULLIDE:-build/bin/cullide}
 OUT=${OUT:-/tmp/cullide-hunt-docs}
-BUDGET=${1:-40}
+CASES=${1:-6}
 mkdir -p "$OUT" docs/data
 echo "load: $(uptime)" >&2
 
@@ -29,12 +30,12 @@ PY
 
 echo "method,resolution,depth,source,cases,failing,true_pairs,missed_pairs,seconds,first_finding" > docs/data/hunt_scenes.csv
 for scene in cylinders tori bunny-dragon breaking leaves cloth; do
-  "$CULLIDE" hunt --method cullide --scene "$scene" --budget-s "$BUDGET" --max-findings 1 --shrink-checks 300 \
+  "$CULLIDE" hunt --method cullide --scene "$scene" --cases "$CASES" --max-findings 1 --shrink-checks 300 \
     --no-progress --out "$OUT/scene-$scene" > "$OUT/scene-$scene.log"
   rows "$OUT/scene-$scene/summary.json" >> docs/data/hunt_scenes.csv
 done
 # Cloth's own pairs are self-collisions, which only Quick-CULLIDE reports.
-"$CULLIDE" hunt --method qcullide-gl --self --scene cloth --budget-s "$BUDGET" --max-findings 1 --shrink-checks 300 \
+"$CULLIDE" hunt --method qcullide-gl --self --scene cloth --cases "$CASES" --max-findings 1 --shrink-checks 300 \
   --no-progress --out "$OUT/scene-cloth-self" > "$OUT/scene-cloth-self.log"
 rows "$OUT/scene-cloth-self/summary.json" >> docs/data/hunt_scenes.csv
 

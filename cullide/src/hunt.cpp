@@ -595,11 +595,27 @@ Frame shrink(const Frame& failing, const RunOptions& options, FrameContext& cont
         if (s.checks >= max_checks || (stop && stop())) s.stopped = true;
         return s.stopped;
     };
+    // A miss of a crossing pair (interpenetration, the serious kind) stays one: when the input has
+    // one, every step must keep one, so the shrinker cannot trade it for a mere touching contact
+    // (two walls of a room meeting at a corner) that happens to be missed too.
+    const auto crossing_miss = [&](const Frame& f, const Verdict& v) {
+        return std::any_of(v.missed.begin(), v.missed.end(), [&](const TrianglePair& p) {
+            const Mesh &a = f[p.object_a], &b = f[p.object_b];
+            const Tri &ta = a.triangles[p.triangle_a], &tb = b.triangles[p.triangle_b];
+            return tri_tri_relation(a.positions[ta[0]], a.positions[ta[1]], a.positions[ta[2]], b.positions[tb[0]],
+                                    b.positions[tb[1]], b.positions[tb[2]]) == TriRelation::Crossing;
+        });
+    };
+    bool want_crossing = false;
+    if (Result<Verdict> v0 = check(failing, options, context); v0) want_crossing = crossing_miss(failing, v0.value());
+    const auto same_failure = [&](const Frame& f, const Verdict& v) {
+        return v.failed() && (!want_crossing || crossing_miss(f, v));
+    };
     const auto fails = [&](const Frame& f) {
         if (f.empty()) return false;
         ++s.checks;
         Result<Verdict> v = check(f, options, context);
-        return v && v.value().failed();
+        return v && same_failure(f, v.value());
     };
     Frame cur = failing;
 
@@ -637,7 +653,7 @@ Frame shrink(const Frame& failing, const RunOptions& options, FrameContext& cont
         if (f.empty()) return std::nullopt;
         ++s.checks;
         Result<Verdict> v = check(f, options, context);
-        if (!v || !v.value().failed()) return std::nullopt;
+        if (!v || !same_failure(f, v.value())) return std::nullopt;
         Result<Reason> r = classify(f, v.value(), options, context);
         s.checks += 4;
         if (!r) return std::nullopt;

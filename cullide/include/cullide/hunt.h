@@ -96,7 +96,8 @@ struct ShrinkStats {
 };
 
 // Shrinks a failing frame: ddmin over objects, then over all triangles (objects left without one
-// are dropped; unused vertices are removed), keeping a step while check() still fails; then
+// are dropped; unused vertices are removed), keeping a step while check() still fails (and, when the
+// input misses a crossing pair, tri_tri.h's Crossing, while a crossing pair is still missed); then
 // coordinates (the whole frame rounded to a coarser dyadic grid, then each distinct coordinate value,
 // everywhere at once, set to 0, rounded to an integer, to a few binary places, or to fewer mantissa
 // bits), keeping a step only while the failure keeps its kind: the same classify() reason as before
