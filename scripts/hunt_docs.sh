@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The figures of docs/hunt.md: `cullide hunt` on every built-in scene at the papers' resolution
 # (GL-exact CULLIDE at 1024 x 1024, D24), and the axis-aligned room generator across methods,
-# resolutions and depth formats. Writes docs/data/hunt_scenes.csv, docs/data/hunt_room.csv and the
+# resolutions and depth formats. Writes docs/data/hunt_scenes.csv, docs/data/hunt_room.csv, the two
+# SVG figures docs/img/hunt_room_*.svg (scripts/hunt_figures.py) and the
 # findings under $OUT (default /tmp/cullide-hunt-docs). Budgets are case counts, not seconds, so the
 # counts (not the times) are the same on every machine. Run from the repository root after a build:
 #   bash scripts/hunt_docs.sh [CASES_PER_SCENE]
@@ -51,4 +52,12 @@ for method in cullide qcullide-gl rcullide-offset rcullide qcullide; do
     done
   done
 done
+# The room figures: one room frame as generated, and the same finding shrunk.
+"$CULLIDE" hunt --method cullide --generators room --cases 1 --shrink-checks 0 --no-progress \
+  --out "$OUT/room-figure-full" > /dev/null
+"$CULLIDE" hunt --method cullide --generators room --cases 1 --no-progress --out "$OUT/room-figure-shrunk" > /dev/null
+python3 scripts/hunt_figures.py views "$OUT/room-figure-full/finding-001" docs/img/hunt_room_frame.svg \
+  "A room frame (generator room, case 0): every true pair is missed by cullide at 1024 px"
+python3 scripts/hunt_figures.py views "$OUT/room-figure-shrunk/finding-001" docs/img/hunt_room_shrunk.svg \
+  "Shrunk: one wall triangle (y = -1) crossed by one mover triangle"
 echo "load: $(uptime)" >&2
