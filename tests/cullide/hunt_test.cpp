@@ -330,6 +330,20 @@ TEST_CASE("cullide hunt perturbs mesh files and built-in scenes") {
     CHECK(has(r.out, "\"name\": \"mesh:" + a.string() + "+" + b.string() + "\", \"cases\": 2"));
     CHECK(has(r.out, "\"name\": \"scene:cylinders\", \"cases\": 2"));
     CHECK(has(r.err, "cullide hunt: method cullide"));  // the report moves to stderr with --json -
+    // The planted miss, given as files, is found within 2 perturbed frames and shrunk below its
+    // 14 triangles; a mesh finding comes first (cases 0 and 2 are the mesh frame's).
+    CHECK(has(r.err, "finding 1: case 0 (mesh:"));
+    CHECK(has(r.out, "\"source\": \"mesh:"));
+    const std::string csv = read_text(dir / "out" / "summary.csv");
+    const std::vector<std::string> rows = lines(csv);
+    REQUIRE(rows.size() >= 2);
+    std::vector<std::string> cells;
+    std::istringstream row(rows[1]);
+    for (std::string c; std::getline(row, c, ',');) cells.push_back(c);
+    REQUIRE(cells.size() > 9);
+    CHECK(cells[6] == "14");                  // triangles_before
+    CHECK(std::stoi(cells[8]) < 14);          // triangles after shrinking
+    CHECK(std::stoi(cells[9]) > 0);           // missed pairs
     fs::remove_all(dir);
 }
 
