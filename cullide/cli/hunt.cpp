@@ -117,7 +117,7 @@ std::uint64_t case_seed(std::uint64_t seed, std::uint64_t index) {
 Frame make_case(const Source& s, std::uint64_t seed, int* scene_frame) {
     if (s.generator) return hunt::generate(*s.generator, seed);
     if (s.base) return hunt::perturb(*s.base, seed);
-    // A frame in 0..599: every built-in scene's period divides 600 or is shorter.
+    // A frame index in 0..599 (20 s of scene time; every scene accepts any index).
     *scene_frame = static_cast<int>(seed % 600);
     return hunt::perturb(s.scene->frame(*scene_frame), seed);
 }
@@ -164,6 +164,11 @@ void write_finding(Finding& fd, const Frame& shrunk, const hunt::Verdict& v, con
     std::error_code ec;
     fs::create_directories(dir, ec);
     if (ec) throw Failure{"cannot create '" + dir.string() + "': " + ec.message()};
+    // An earlier hunt's object files in the same folder would read as part of this finding.
+    for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+        const std::string n = e.path().filename().string();
+        if (n.rfind("object_", 0) == 0 && e.path().extension() == ".obj") fs::remove(e.path(), ec);
+    }
     std::string command = "cullide run";
     std::vector<Mesh> read_back;
     for (std::size_t i = 0; i < shrunk.size(); ++i) {

@@ -263,8 +263,11 @@ TEST_CASE("cullide hunt writes each finding, and its run command reproduces the 
     const std::vector<std::string> args{"hunt", "--method", "cullide", "--resolution", "64", "--generators",
                                         "edge-on,room", "--cases", "6", "--max-findings", "2", "--seed", "7",
                                         "--out", dir.string()};
+    fs::create_directories(dir / "finding-001");
+    std::ofstream(dir / "finding-001" / "object_9.obj") << "# left by an earlier hunt\n";
     const Outcome r = cli(args);
     REQUIRE(r.status == 0);
+    CHECK_FALSE(fs::exists(dir / "finding-001" / "object_9.obj"));  // not mistaken for part of the finding
     CHECK(has(r.out, "finding 1: case "));
     CHECK(has(r.out, "6 cases"));
     const std::vector<std::string> rows = lines(read_text(dir / "summary.csv"));
