@@ -30,15 +30,18 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-// Set by SIGINT while a hunt runs; the loop and the shrinker ask it between frames.
-volatile std::sig_atomic_t g_interrupted = 0;
-extern "C" void on_sigint(int) { g_interrupted = 1; }
+// Set by SIGINT while a hunt runs; the loop and the shrinker ask it between frames. A lock-free
+// atomic (allowed in a signal handler), not a volatile flag, because the handler may run on any
+// thread (a signal raised by another thread, as in the test) and the loop reads it on this one.
+std::atomic<bool> g_interrupted{false};
+static_assert(std::atomic<bool>::is_always_lock_free);
+extern "C" void on_sigint(int) { g_interrupted.store(true, std::memory_order_relaxed); }
 
 // SIGINT handled for the scope of one hunt, the previous handler restored after.
 class SigintScope {
    public:
     SigintScope() {
-        g_interrupted = 0;
+        g_interrupted.store(false);
         previous_ = std::signal(SIGINT, on_sigint);
     }
     ~SigintScope() { std::signal(SIGINT, previous_ == SIG_ERR ? SIG_DFL : previous_); }
@@ -335,7 +338,8 @@ int hunt_main(const Settings& s, std::ostream& stdout_stream, std::ostream& err)
     const SigintScope sigint;
     const Clock::time_point start = Clock::now();
     const auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
-    const auto out_of_time = [&] { return g_interrupted != 0 || (budget && elapsed() >= *budget); };
+    const auto interrupted = [] { return g_interrupted.load(std::memory_order_relaxed); };
+    const auto out_of_time = [&] { return interrupted() || (budget && elapsed() >= *budget); };
     Clock::time_point last_progress = start;
     FrameContext context;
 
@@ -348,7 +352,7 @@ int hunt_main(const Settings& s, std::ostream& stdout_stream, std::ostream& err)
 
     std::uint64_t index = 0;
     for (;; ++index) {
-        if (g_interrupted) {
+        if (interrupted()) {
             sum.stopped_by = "interrupt";
             break;
         }

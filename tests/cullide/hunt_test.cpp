@@ -6,12 +6,15 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "cli.h"
@@ -347,6 +350,31 @@ TEST_CASE("cullide hunt perturbs mesh files and built-in scenes") {
     CHECK(cells[6] == "14");                  // triangles_before
     CHECK(std::stoi(cells[8]) < 14);          // triangles after shrinking
     CHECK(std::stoi(cells[9]) > 0);           // missed pairs
+    fs::remove_all(dir);
+}
+
+extern "C" void ignore_signal(int) {}
+
+TEST_CASE("Ctrl-C stops a hunt at the next frame and still writes the summary") {
+    // The test's own handler first, so a signal that came before the hunt installed its own would be
+    // harmless (and the elapsed-time check below would catch it).
+    const auto previous = std::signal(SIGINT, ignore_signal);
+    const fs::path dir = temp_dir("sigint");
+    const auto start = std::chrono::steady_clock::now();
+    std::thread interrupter([] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(300));
+        std::raise(SIGINT);
+    });
+    const Outcome r = cli({"hunt", "--method", "cullide", "--generators", "room", "--budget-s", "120", "--out",
+                           dir.string()});
+    interrupter.join();
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::signal(SIGINT, previous);
+    CHECK(r.status == 0);
+    CHECK(has(r.out, "(stopped by interrupt)"));
+    CHECK(seconds < 60);  // far below the budget
+    CHECK(has(read_text(dir / "summary.json"), "\"stopped_by\": \"interrupt\""));
+    CHECK(fs::exists(dir / "summary.csv"));
     fs::remove_all(dir);
 }
 
