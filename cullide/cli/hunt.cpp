@@ -17,11 +17,11 @@
 #include <sstream>
 
 #include "bench.h"
-#include "help.h"
 #include "cullide/hunt.h"
 #include "cullide/mesh_io.h"
 #include "cullide/pipeline.h"
 #include "cullide/scenes.h"
+#include "help.h"
 #include "options.h"
 
 namespace cullide::cli {
@@ -39,7 +39,7 @@ extern "C" void on_sigint(int) { g_interrupted.store(true, std::memory_order_rel
 
 // SIGINT handled for the scope of one hunt, the previous handler restored after.
 class SigintScope {
-   public:
+ public:
     SigintScope() {
         g_interrupted.store(false);
         previous_ = std::signal(SIGINT, on_sigint);
@@ -48,7 +48,7 @@ class SigintScope {
     SigintScope(const SigintScope&) = delete;
     SigintScope& operator=(const SigintScope&) = delete;
 
-   private:
+ private:
     void (*previous_)(int) = SIG_DFL;
 };
 
@@ -75,8 +75,9 @@ std::string json_escape(const std::string& s) {
 
 // A word for a POSIX shell: as it is when it is plain, else in single quotes.
 std::string shell_word(const std::string& s) {
-    const bool plain = !s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
-                                                         "_-+=./,:@%") == std::string::npos;
+    const bool plain = !s.empty() && s.find_first_not_of(
+                                         "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
+                                         "_-+=./,:@%") == std::string::npos;
     if (plain) return s;
     std::string q = "'";
     for (char c : s) {
@@ -105,8 +106,8 @@ std::uint64_t triangle_count(const Frame& f) {
 struct Source {
     std::string name;
     std::optional<hunt::Generator> generator;
-    const Frame* base = nullptr;                  // --mesh: perturbations of this frame
-    std::shared_ptr<SceneGenerator> scene;        // --scene: perturbations of its frames
+    const Frame* base = nullptr;            // --mesh: perturbations of this frame
+    std::shared_ptr<SceneGenerator> scene;  // --scene: perturbations of its frames
 };
 
 // The frame of case `index` and its seed.
@@ -143,9 +144,11 @@ struct Finding {
 std::string run_settings(const RunOptions& o) {
     std::ostringstream c;
     c << " --method " << to_string(o.method) << " --resolution " << o.resolution << " --depth-format "
-      << to_string(o.depth_format) << " --subobject " << o.subobject_triangles << " --rounds " << o.max_rounds;
+      << to_string(o.depth_format) << " --subobject " << o.subobject_triangles << " --rounds "
+      << o.max_rounds;
     if (o.min_prune >= 0) c << " --min-prune " << std::setprecision(17) << o.min_prune;
-    if (o.object_stage != ObjectStage::Auto) c << " --object-stage " << (o.object_stage == ObjectStage::On ? "on" : "off");
+    if (o.object_stage != ObjectStage::Auto)
+        c << " --object-stage " << (o.object_stage == ObjectStage::On ? "on" : "off");
     if (o.broadphase != BroadPhase::None) c << " --broadphase " << to_string(o.broadphase);
     if (o.self) c << " --self";
     return c.str();
@@ -188,18 +191,21 @@ void write_finding(Finding& fd, const Frame& shrunk, const hunt::Verdict& v, con
     std::ostringstream pairs;
     pairs << "kind,object_a,triangle_a,object_b,triangle_b\n";
     for (const TrianglePair& p : v.missed)
-        pairs << "missed," << p.object_a << ',' << p.triangle_a << ',' << p.object_b << ',' << p.triangle_b << '\n';
+        pairs << "missed," << p.object_a << ',' << p.triangle_a << ',' << p.object_b << ',' << p.triangle_b
+              << '\n';
     for (const TrianglePair& p : v.extra)
-        pairs << "extra," << p.object_a << ',' << p.triangle_a << ',' << p.object_b << ',' << p.triangle_b << '\n';
+        pairs << "extra," << p.object_a << ',' << p.triangle_a << ',' << p.object_b << ',' << p.triangle_b
+              << '\n';
     write_file(dir / "pairs.csv", pairs.str());
     write_file(dir / "command.txt", command + "\n");
     std::ostringstream about;
     about << "source " << fd.source;
     if (fd.scene_frame >= 0) about << " frame " << fd.scene_frame << " (perturbed)";
     about << ", case " << fd.case_index << ", case seed " << hex(fd.seed) << "\n"
-          << "before shrinking: " << fd.objects_before << " objects, " << fd.triangles_before << " triangles\n"
-          << "after: " << fd.objects << " objects, " << fd.triangles << " triangles ("
-          << fd.shrink_checks << " frames run" << (fd.shrink_complete ? "" : ", stopped early") << ")\n"
+          << "before shrinking: " << fd.objects_before << " objects, " << fd.triangles_before
+          << " triangles\n"
+          << "after: " << fd.objects << " objects, " << fd.triangles << " triangles (" << fd.shrink_checks
+          << " frames run" << (fd.shrink_complete ? "" : ", stopped early") << ")\n"
           << "missed pairs " << fd.missed << ", extra pairs " << fd.extra << "\n"
           << "reason " << fd.reason << "\n";
     write_file(dir / "reason.txt", about.str());
@@ -210,7 +216,8 @@ void write_finding(Finding& fd, const Frame& shrunk, const hunt::Verdict& v, con
 }
 
 const char* kCsvHeader =
-    "finding,case,source,scene_frame,case_seed,objects_before,triangles_before,objects,triangles,missed_pairs,"
+    "finding,case,source,scene_frame,case_seed,objects_before,triangles_before,objects,triangles,missed_"
+    "pairs,"
     "extra_pairs,reason,shrink_checks,shrink_complete,reproduced,dir,command\n";
 
 std::string csv_field(const std::string& s) {
@@ -225,9 +232,9 @@ std::string csv_field(const std::string& s) {
 
 std::string csv_row(const Finding& f) {
     std::ostringstream o;
-    o << f.number << ',' << f.case_index << ',' << csv_field(f.source) << ',' << f.scene_frame << ',' << hex(f.seed)
-      << ',' << f.objects_before << ',' << f.triangles_before << ',' << f.objects << ',' << f.triangles << ','
-      << f.missed << ',' << f.extra << ',' << f.reason << ',' << f.shrink_checks << ','
+    o << f.number << ',' << f.case_index << ',' << csv_field(f.source) << ',' << f.scene_frame << ','
+      << hex(f.seed) << ',' << f.objects_before << ',' << f.triangles_before << ',' << f.objects << ','
+      << f.triangles << ',' << f.missed << ',' << f.extra << ',' << f.reason << ',' << f.shrink_checks << ','
       << (f.shrink_complete ? "yes" : "no") << ',' << (f.reproduced ? "yes" : "no") << ',' << csv_field(f.dir)
       << ',' << csv_field(f.command) << '\n';
     return o.str();
@@ -252,28 +259,30 @@ struct Summary {
 std::string summary_json(const Summary& s) {
     std::ostringstream o;
     const RunOptions& p = s.options;
-    o << "{\"method\": \"" << to_string(p.method) << "\", \"resolution\": " << p.resolution << ", \"depth_format\": \""
-      << to_string(p.depth_format) << "\", \"subobject\": " << p.subobject_triangles << ", \"rounds\": "
-      << p.max_rounds << ", \"self\": " << (p.self ? "true" : "false") << ", \"seed\": " << s.seed
-      << ", \"sources\": [";
+    o << "{\"method\": \"" << to_string(p.method) << "\", \"resolution\": " << p.resolution
+      << ", \"depth_format\": \"" << to_string(p.depth_format)
+      << "\", \"subobject\": " << p.subobject_triangles << ", \"rounds\": " << p.max_rounds
+      << ", \"self\": " << (p.self ? "true" : "false") << ", \"seed\": " << s.seed << ", \"sources\": [";
     for (std::size_t i = 0; i < s.sources.size(); ++i) {
         const SourceStats& x = s.sources[i];
         o << (i ? ", " : "") << "{\"name\": \"" << json_escape(x.name) << "\", \"cases\": " << x.cases
-          << ", \"failing_cases\": " << x.failing << ", \"true_pairs\": " << x.true_pairs << ", \"missed_pairs\": "
-          << x.missed << ", \"extra_pairs\": " << x.extra << "}";
+          << ", \"failing_cases\": " << x.failing << ", \"true_pairs\": " << x.true_pairs
+          << ", \"missed_pairs\": " << x.missed << ", \"extra_pairs\": " << x.extra << "}";
     }
     o << "], \"cases\": " << s.cases << ", \"seconds\": " << std::fixed << std::setprecision(3) << s.seconds
       << std::defaultfloat << ", \"stopped_by\": \"" << s.stopped_by << "\", \"findings\": [";
     for (std::size_t i = 0; i < s.findings.size(); ++i) {
         const Finding& f = s.findings[i];
-        o << (i ? ", " : "") << "{\"finding\": " << f.number << ", \"case\": " << f.case_index << ", \"source\": \""
-          << json_escape(f.source) << "\", \"scene_frame\": " << f.scene_frame << ", \"case_seed\": \"" << hex(f.seed)
-          << "\", \"objects_before\": " << f.objects_before << ", \"triangles_before\": " << f.triangles_before
-          << ", \"objects\": " << f.objects << ", \"triangles\": " << f.triangles << ", \"missed_pairs\": " << f.missed
-          << ", \"extra_pairs\": " << f.extra << ", \"reason\": \"" << f.reason << "\", \"shrink_checks\": "
-          << f.shrink_checks << ", \"shrink_complete\": " << (f.shrink_complete ? "true" : "false")
-          << ", \"reproduced\": " << (f.reproduced ? "true" : "false") << ", \"dir\": \"" << json_escape(f.dir)
-          << "\", \"command\": \"" << json_escape(f.command) << "\"}";
+        o << (i ? ", " : "") << "{\"finding\": " << f.number << ", \"case\": " << f.case_index
+          << ", \"source\": \"" << json_escape(f.source) << "\", \"scene_frame\": " << f.scene_frame
+          << ", \"case_seed\": \"" << hex(f.seed) << "\", \"objects_before\": " << f.objects_before
+          << ", \"triangles_before\": " << f.triangles_before << ", \"objects\": " << f.objects
+          << ", \"triangles\": " << f.triangles << ", \"missed_pairs\": " << f.missed
+          << ", \"extra_pairs\": " << f.extra << ", \"reason\": \"" << f.reason
+          << "\", \"shrink_checks\": " << f.shrink_checks
+          << ", \"shrink_complete\": " << (f.shrink_complete ? "true" : "false")
+          << ", \"reproduced\": " << (f.reproduced ? "true" : "false") << ", \"dir\": \""
+          << json_escape(f.dir) << "\", \"command\": \"" << json_escape(f.command) << "\"}";
     }
     o << "]}\n";
     return o.str();
@@ -295,7 +304,8 @@ void emit(const std::string& path, const std::string& text, std::ostream& out) {
 }
 
 int hunt_main(const Settings& s, std::ostream& stdout_stream, std::ostream& err) {
-    if (s.csv_path == "-" && s.json_path == "-") throw UsageError{"--csv - and --json - cannot both go to stdout"};
+    if (s.csv_path == "-" && s.json_path == "-")
+        throw UsageError{"--csv - and --json - cannot both go to stdout"};
     // The report goes to stderr when a summary takes stdout.
     std::ostream& out = s.csv_path == "-" || s.json_path == "-" ? err : stdout_stream;
     RunOptions opt = s.pipeline;
@@ -305,7 +315,8 @@ int hunt_main(const Settings& s, std::ostream& stdout_stream, std::ostream& err)
     std::vector<std::string> gens = s.generators;
     if (gens.empty() && s.mesh_files.empty() && s.hunt_scenes.empty()) gens = hunt::generator_names();
     std::vector<Source> sources;
-    for (const std::string& g : gens) sources.push_back({g, hunt::parse_generator(g).value(), nullptr, nullptr});
+    for (const std::string& g : gens)
+        sources.push_back({g, hunt::parse_generator(g).value(), nullptr, nullptr});
     Frame mesh_frame;
     if (!s.mesh_files.empty()) {
         std::string label;
@@ -320,10 +331,12 @@ int hunt_main(const Settings& s, std::ostream& stdout_stream, std::ostream& err)
     for (const std::string& name : s.hunt_scenes) {
         Result<std::unique_ptr<SceneGenerator>> g = make_scene(name, s.scene);
         if (!g) throw Failure{g.error().message};
-        sources.push_back({"scene:" + name, std::nullopt, nullptr, std::shared_ptr<SceneGenerator>(std::move(g).value())});
+        sources.push_back(
+            {"scene:" + name, std::nullopt, nullptr, std::shared_ptr<SceneGenerator>(std::move(g).value())});
     }
 
-    const std::optional<double> budget = s.budget_s ? s.budget_s : (s.cases ? std::nullopt : std::optional<double>(30.0));
+    const std::optional<double> budget =
+        s.budget_s ? s.budget_s : (s.cases ? std::nullopt : std::optional<double>(30.0));
     const fs::path out_dir = s.out_dir;
     std::error_code ec;
     fs::create_directories(out_dir, ec);
@@ -344,8 +357,9 @@ int hunt_main(const Settings& s, std::ostream& stdout_stream, std::ostream& err)
     FrameContext context;
 
     out << "cullide hunt: method " << to_string(opt.method) << ", resolution " << opt.resolution << ", depth "
-        << to_string(opt.depth_format) << ", sub-object " << opt.subobject_triangles << ", rounds " << opt.max_rounds
-        << ", seed " << s.scene.seed << ", " << sources.size() << " source" << (sources.size() == 1 ? "" : "s");
+        << to_string(opt.depth_format) << ", sub-object " << opt.subobject_triangles << ", rounds "
+        << opt.max_rounds << ", seed " << s.scene.seed << ", " << sources.size() << " source"
+        << (sources.size() == 1 ? "" : "s");
     if (budget) out << ", budget " << *budget << " s";
     if (s.cases) out << ", at most " << *s.cases << " cases";
     out << "\n";
@@ -404,28 +418,32 @@ int hunt_main(const Settings& s, std::ostream& stdout_stream, std::ostream& err)
         Result<hunt::Verdict> sv = hunt::check(shrunk, opt, context);
         if (!sv) throw Failure{"shrunk case " + std::to_string(index) + ": " + sv.error().message};
         Result<hunt::Reason> reason = hunt::classify(shrunk, sv.value(), opt, context);
-        if (!reason) throw Failure{"classifying case " + std::to_string(index) + ": " + reason.error().message};
+        if (!reason)
+            throw Failure{"classifying case " + std::to_string(index) + ": " + reason.error().message};
         fd.reason = hunt::to_string(reason.value());
         fd.missed = sv.value().missed.size();
         fd.extra = sv.value().extra.size();
         write_finding(fd, shrunk, sv.value(), opt, out_dir, context);
         if (progress) err << "\r" << std::string(60, ' ') << "\r";
         out << "finding " << fd.number << ": case " << index << " (" << src.name << "): " << fd.objects_before
-            << " objects, " << fd.triangles_before << " triangles -> " << fd.objects << " objects, " << fd.triangles
-            << " triangles; " << fd.missed << " missed, " << fd.extra << " extra pairs; reason " << fd.reason
-            << (fd.reproduced ? "" : "; NOT reproduced from the written files") << "\n  " << fd.command << "\n";
+            << " objects, " << fd.triangles_before << " triangles -> " << fd.objects << " objects, "
+            << fd.triangles << " triangles; " << fd.missed << " missed, " << fd.extra
+            << " extra pairs; reason " << fd.reason
+            << (fd.reproduced ? "" : "; NOT reproduced from the written files") << "\n  " << fd.command
+            << "\n";
         sum.findings.push_back(std::move(fd));
     }
     if (progress) err << "\r" << std::string(60, ' ') << "\r";
     sum.cases = index;
     sum.seconds = elapsed();
     out << "hunt: " << sum.cases << " cases in " << std::fixed << std::setprecision(1) << sum.seconds
-        << std::defaultfloat << " s, " << sum.findings.size() << " finding" << (sum.findings.size() == 1 ? "" : "s")
-        << " (stopped by " << sum.stopped_by << "); written to " << out_dir.string() << "\n";
+        << std::defaultfloat << " s, " << sum.findings.size() << " finding"
+        << (sum.findings.size() == 1 ? "" : "s") << " (stopped by " << sum.stopped_by << "); written to "
+        << out_dir.string() << "\n";
     for (const SourceStats& x : sum.sources) {
         if (x.cases == 0) continue;
-        out << "  " << x.name << ": " << x.cases << " cases, " << x.failing << " failing; " << x.missed << " of "
-            << x.true_pairs << " true pairs missed";
+        out << "  " << x.name << ": " << x.cases << " cases, " << x.failing << " failing; " << x.missed
+            << " of " << x.true_pairs << " true pairs missed";
         if (x.extra) out << ", " << x.extra << " extra pairs";
         out << "\n";
     }

@@ -412,36 +412,43 @@ void add_hunt_options(std::vector<OptionSpec>& t) {
                  [](const OptionSpec& o, const std::string& v, Settings& s) {
                      const std::vector<std::string> names = scene_names();
                      if (std::find(names.begin(), names.end(), v) == names.end())
-                         throw UsageError{o.name + ": unknown scene '" + v + "' (valid: " + joined(names) + ")"};
+                         throw UsageError{o.name + ": unknown scene '" + v + "' (valid: " + joined(names) +
+                                          ")"};
                      s.hunt_scenes.push_back(v);
                  }});
-    t.push_back({"--budget-s", "S", kHuntOnly, "stop after S seconds of searching (Ctrl-C also stops, keeping what was found)",
+    t.push_back({"--budget-s", "S", kHuntOnly,
+                 "stop after S seconds of searching (Ctrl-C also stops, keeping what was found)",
                  reals(0, true, 604800, false), "30 when --cases is not given", "",
-                 [](const OptionSpec& o, const std::string& v, Settings& s) { s.budget_s = real_value(o, v, false); }});
-    t.push_back({"--cases", "N", kHuntOnly, "stop after N generated frames", integers(1, 1000000000), "no limit", "",
                  [](const OptionSpec& o, const std::string& v, Settings& s) {
+                     s.budget_s = real_value(o, v, false);
+                 }});
+    t.push_back({"--cases", "N", kHuntOnly, "stop after N generated frames", integers(1, 1000000000),
+                 "no limit", "", [](const OptionSpec& o, const std::string& v, Settings& s) {
                      s.cases = static_cast<std::uint64_t>(int_value(o, v));
                  }});
-    t.push_back({"--max-findings", "N", kHuntOnly, "shrink and write the first N findings; later failing frames are only counted",
-                 integers(1, 100000), "10", "",
-                 [](const OptionSpec& o, const std::string& v, Settings& s) { s.max_findings = int_value(o, v); }});
-    t.push_back({"--shrink-checks", "N", kHuntOnly, "at most N frames run to shrink one finding", integers(0, 100000000),
-                 "2000", "",
+    t.push_back({"--max-findings", "N", kHuntOnly,
+                 "shrink and write the first N findings; later failing frames are only counted",
+                 integers(1, 100000), "10", "", [](const OptionSpec& o, const std::string& v, Settings& s) {
+                     s.max_findings = int_value(o, v);
+                 }});
+    t.push_back({"--shrink-checks", "N", kHuntOnly, "at most N frames run to shrink one finding",
+                 integers(0, 100000000), "2000", "",
                  [](const OptionSpec& o, const std::string& v, Settings& s) {
                      s.shrink_checks = static_cast<std::uint64_t>(int_value(o, v));
                  }});
-    t.push_back({"--out",
-                 "DIR",
-                 kHuntOnly,
-                 "where findings are written, one folder each (OBJ files, the run command, the missed pairs), "
-                 "with summary.csv and summary.json",
-                 {},
-                 "hunt-out",
-                 "",
-                 [](const OptionSpec&, const std::string& v, Settings& s) {
-                     if (v.empty()) throw UsageError{"--out needs a folder name"};
-                     s.out_dir = v;
-                 }});
+    t.push_back(
+        {"--out",
+         "DIR",
+         kHuntOnly,
+         "where findings are written, one folder each (OBJ files, the run command, the missed pairs), "
+         "with summary.csv and summary.json",
+         {},
+         "hunt-out",
+         "",
+         [](const OptionSpec&, const std::string& v, Settings& s) {
+             if (v.empty()) throw UsageError{"--out needs a folder name"};
+             s.out_dir = v;
+         }});
     t.push_back({"--csv",
                  "FILE",
                  kHuntOnly,
@@ -557,9 +564,10 @@ Settings parse_options(Command command, const std::vector<std::string>& args) {
                 s.inputs.push_back(a);
                 continue;
             }
-            throw UsageError{"unknown option '" + a + "'" +
-                             (command == Command::Hunt ? " (mesh files are given with --mesh, scenes with --scene)"
-                                                       : " (scenes are given with --scenes)")};
+            const char* where = command == Command::Hunt
+                                    ? " (mesh files are given with --mesh, scenes with --scene)"
+                                    : " (scenes are given with --scenes)";
+            throw UsageError{"unknown option '" + a + "'" + where};
         }
         const auto spec = std::find_if(table.begin(), table.end(), [&](const OptionSpec& o) {
             return o.name == a && takes(o.commands, command);

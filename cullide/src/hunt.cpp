@@ -22,7 +22,7 @@ namespace cullide::hunt {
 namespace {
 
 class Rng {
-   public:
+ public:
     explicit Rng(std::uint64_t seed) : s_(seed) {}
     std::uint64_t next() {
         std::uint64_t z = (s_ += 0x9E3779B97F4A7C15ULL);
@@ -37,12 +37,14 @@ class Rng {
     bool coin(int percent = 50) { return below(100) < percent; }
     Vec3 point(double lo, double hi) { return {range(lo, hi), range(lo, hi), range(lo, hi)}; }
 
-   private:
+ private:
     std::uint64_t s_;
 };
 
 // A seed's stream for one purpose, independent of the others drawn from the same seed.
-std::uint64_t mix(std::uint64_t seed, std::uint64_t salt) { return Rng(seed ^ (salt * 0xD1B54A32D192ED03ULL)).next(); }
+std::uint64_t mix(std::uint64_t seed, std::uint64_t salt) {
+    return Rng(seed ^ (salt * 0xD1B54A32D192ED03ULL)).next();
+}
 
 Mesh triangles_mesh(std::string name, const std::vector<std::array<Vec3, 3>>& tris) {
     Mesh m;
@@ -61,7 +63,8 @@ Mesh box(std::string name, Vec3 lo, Vec3 hi) {
     m.name = std::move(name);
     for (int i = 0; i < 8; ++i)
         m.positions.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
-    const std::uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    const std::uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                   {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
     for (const auto& f : q) {
         m.triangles.push_back({f[0], f[1], f[2]});
         m.triangles.push_back({f[0], f[2], f[3]});
@@ -155,16 +158,20 @@ Frame coplanar(Rng& r) {
     const int objects = r.between(2, 4);
     for (int o = 0; o < objects; ++o) {
         // Touching exactly (offset 0) half the time, else a power-of-two gap or overlap.
-        const double offset = o == 0 || r.coin() ? 0.0 : (r.coin() ? 1 : -1) * std::ldexp(1.0, -r.between(8, 40));
+        const double offset =
+            o == 0 || r.coin() ? 0.0 : (r.coin() ? 1 : -1) * std::ldexp(1.0, -r.between(8, 40));
         std::vector<std::array<Vec3, 3>> tris;
         const int n = r.between(1, 4);
         for (int t = 0; t < n; ++t) {
             std::array<Vec3, 3> tri;
-            for (Vec3& q : tri) q = on_plane(p, grid_or_raw(r, r.coin(), -0.6, 0.6), grid_or_raw(r, r.coin(), -0.6, 0.6), offset);
+            for (Vec3& q : tri)
+                q = on_plane(p, grid_or_raw(r, r.coin(), -0.6, 0.6), grid_or_raw(r, r.coin(), -0.6, 0.6),
+                             offset);
             tris.push_back(tri);
         }
         if (r.coin(30)) {  // a triangle leaving the plane, so the object is not flat
-            tris.push_back({on_plane(p, 0, 0, offset), on_plane(p, 0.3, 0, offset), on_plane(p, 0.1, 0.1, offset + r.range(-0.5, 0.5))});
+            tris.push_back({on_plane(p, 0, 0, offset), on_plane(p, 0.3, 0, offset),
+                            on_plane(p, 0.1, 0.1, offset + r.range(-0.5, 0.5))});
         }
         f.push_back(triangles_mesh("plane_" + std::to_string(o), tris));
     }
@@ -183,13 +190,15 @@ Frame grazing(Rng& r) {
         const Vec3 away = r.point(-0.6, 0.6);
         switch (r.below(3)) {
             case 0:  // a tetrahedron whose apex is a vertex of the base triangle
-                f.push_back(tetra("apex_" + std::to_string(o), a[static_cast<std::size_t>(r.below(3))], away + r.point(-0.2, 0.2),
-                                  away + r.point(-0.2, 0.2), away + r.point(-0.2, 0.2)));
+                f.push_back(tetra("apex_" + std::to_string(o), a[static_cast<std::size_t>(r.below(3))],
+                                  away + r.point(-0.2, 0.2), away + r.point(-0.2, 0.2),
+                                  away + r.point(-0.2, 0.2)));
                 break;
             case 1: {  // a triangle sharing an edge of the base, folded out of its plane
                 const int e = r.below(3);
-                f.push_back(triangles_mesh("hinge_" + std::to_string(o),
-                                           {{a[static_cast<std::size_t>(e)], a[static_cast<std::size_t>((e + 1) % 3)], away}}));
+                f.push_back(triangles_mesh(
+                    "hinge_" + std::to_string(o),
+                    {{a[static_cast<std::size_t>(e)], a[static_cast<std::size_t>((e + 1) % 3)], away}}));
                 break;
             }
             default: {  // boxes on a grid, touching face to face or at a corner or edge
@@ -270,8 +279,8 @@ Frame edge_on(Rng& r) {
         f.push_back(wall("wall_" + std::to_string(w), axis, c, -1, 1, r.between(1, 2)));
         const int crossers = r.between(1, 2);
         for (int o = 0; o < crossers; ++o)
-            f.push_back(crosser(r, "crosser_" + std::to_string(w) + "_" + std::to_string(o), axis, c, r.range(-0.8, 0.8),
-                                r.range(-0.8, 0.8)));
+            f.push_back(crosser(r, "crosser_" + std::to_string(w) + "_" + std::to_string(o), axis, c,
+                                r.range(-0.8, 0.8), r.range(-0.8, 0.8)));
     }
     return f;
 }
@@ -288,7 +297,7 @@ Frame sliver(Rng& r) {
             Vec3 c;
             if (r.coin()) {  // needle: the third vertex next to the first
                 c = a + thin * r.point(-1, 1);
-            } else {         // cap: the third vertex next to the middle of a b
+            } else {  // cap: the third vertex next to the middle of a b
                 c = 0.5 * (a + b) + thin * r.point(-1, 1);
             }
             tris.push_back({a, b, c});
@@ -324,8 +333,8 @@ Frame room(Rng& r) {
     all.name = "room";
     for (int axis = 0; axis < 3; ++axis)
         for (int side = 0; side < 2; ++side) {
-            Mesh w = wall(std::string("wall_") + "xyz"[axis] + (side ? "+" : "-"), axis, side ? half : -half, -half, half,
-                          cells);
+            Mesh w = wall(std::string("wall_") + "xyz"[axis] + (side ? "+" : "-"), axis, side ? half : -half,
+                          -half, half, cells);
             if (!one_object) {
                 f.push_back(std::move(w));
                 continue;
@@ -338,8 +347,8 @@ Frame room(Rng& r) {
     const int movers = r.between(1, 3);
     for (int o = 0; o < movers; ++o) {
         const int axis = r.below(3);
-        f.push_back(crosser(r, "mover_" + std::to_string(o), axis, r.coin() ? half : -half, r.range(-0.7, 0.7),
-                            r.range(-0.7, 0.7)));
+        f.push_back(crosser(r, "mover_" + std::to_string(o), axis, r.coin() ? half : -half,
+                            r.range(-0.7, 0.7), r.range(-0.7, 0.7)));
     }
     return f;
 }
@@ -373,7 +382,8 @@ Vec3 centre_of(const Mesh& m) {
 
 // ddmin: the smallest subset of 0..n-1 found for which fails(subset) holds (1-minimal when the check
 // budget and the stop function allow). `fails` is called with sorted index lists.
-std::vector<std::size_t> ddmin(std::size_t n, const std::function<bool(const std::vector<std::size_t>&)>& fails,
+std::vector<std::size_t> ddmin(std::size_t n,
+                               const std::function<bool(const std::vector<std::size_t>&)>& fails,
                                const std::function<bool()>& out_of_budget) {
     std::vector<std::size_t> items(n);
     for (std::size_t i = 0; i < n; ++i) items[i] = i;
@@ -453,7 +463,9 @@ std::size_t degenerate_triangles(const Frame& f) {
     for (const Mesh& m : f)
         for (const Tri& t : m.triangles) {
             const Vec3 &a = m.positions[t[0]], &b = m.positions[t[1]], &c = m.positions[t[2]];
-            if (orient2d_drop(a, b, c, 0) == 0 && orient2d_drop(a, b, c, 1) == 0 && orient2d_drop(a, b, c, 2) == 0) ++n;
+            if (orient2d_drop(a, b, c, 0) == 0 && orient2d_drop(a, b, c, 1) == 0 &&
+                orient2d_drop(a, b, c, 2) == 0)
+                ++n;
         }
     return n;
 }
@@ -476,7 +488,8 @@ std::vector<double> simpler_values(double x) {
     }
     std::vector<double> out;
     for (double v : c)
-        if (v != x && std::isfinite(v) && predicate_coordinate_ok(v) && std::find(out.begin(), out.end(), v) == out.end())
+        if (v != x && std::isfinite(v) && predicate_coordinate_ok(v) &&
+            std::find(out.begin(), out.end(), v) == out.end())
             out.push_back(v);
     return out;
 }
@@ -485,14 +498,22 @@ std::vector<double> simpler_values(double x) {
 
 const char* to_string(Generator g) {
     switch (g) {
-        case Generator::Soup: return "soup";
-        case Generator::Coplanar: return "coplanar";
-        case Generator::Grazing: return "grazing";
-        case Generator::SubPixel: return "subpixel";
-        case Generator::EdgeOn: return "edge-on";
-        case Generator::Sliver: return "sliver";
-        case Generator::Extreme: return "extreme";
-        case Generator::Room: return "room";
+        case Generator::Soup:
+            return "soup";
+        case Generator::Coplanar:
+            return "coplanar";
+        case Generator::Grazing:
+            return "grazing";
+        case Generator::SubPixel:
+            return "subpixel";
+        case Generator::EdgeOn:
+            return "edge-on";
+        case Generator::Sliver:
+            return "sliver";
+        case Generator::Extreme:
+            return "extreme";
+        case Generator::Room:
+            return "room";
     }
     return "?";
 }
@@ -520,14 +541,30 @@ Frame generate(Generator g, std::uint64_t seed) {
     Rng r(mix(seed, static_cast<std::uint64_t>(g) + 1));
     Frame f;
     switch (g) {
-        case Generator::Soup: f = soup(r); break;
-        case Generator::Coplanar: f = coplanar(r); break;
-        case Generator::Grazing: f = grazing(r); break;
-        case Generator::SubPixel: f = sub_pixel(r); break;
-        case Generator::EdgeOn: f = edge_on(r); break;
-        case Generator::Sliver: f = sliver(r); break;
-        case Generator::Extreme: f = extreme(r); break;
-        case Generator::Room: f = room(r); break;
+        case Generator::Soup:
+            f = soup(r);
+            break;
+        case Generator::Coplanar:
+            f = coplanar(r);
+            break;
+        case Generator::Grazing:
+            f = grazing(r);
+            break;
+        case Generator::SubPixel:
+            f = sub_pixel(r);
+            break;
+        case Generator::EdgeOn:
+            f = edge_on(r);
+            break;
+        case Generator::Sliver:
+            f = sliver(r);
+            break;
+        case Generator::Extreme:
+            f = extreme(r);
+            break;
+        case Generator::Room:
+            f = room(r);
+            break;
     }
     clamp_to_exact_range(f);
     return f;
@@ -546,7 +583,8 @@ Frame perturb(const Frame& base, std::uint64_t seed) {
             for (int i = 0; i < moves; ++i) {
                 Mesh& m = f[static_cast<std::size_t>(r.below(static_cast<int>(f.size())))];
                 if (m.positions.empty()) continue;
-                Vec3& p = m.positions[static_cast<std::size_t>(r.below(static_cast<int>(m.positions.size())))];
+                Vec3& p =
+                    m.positions[static_cast<std::size_t>(r.below(static_cast<int>(m.positions.size())))];
                 p = p + std::ldexp(extent, -r.between(4, 30)) * r.point(-1, 1);
             }
             break;
@@ -602,12 +640,14 @@ Frame shrink(const Frame& failing, const RunOptions& options, FrameContext& cont
         return std::any_of(v.missed.begin(), v.missed.end(), [&](const TrianglePair& p) {
             const Mesh &a = f[p.object_a], &b = f[p.object_b];
             const Tri &ta = a.triangles[p.triangle_a], &tb = b.triangles[p.triangle_b];
-            return tri_tri_relation(a.positions[ta[0]], a.positions[ta[1]], a.positions[ta[2]], b.positions[tb[0]],
-                                    b.positions[tb[1]], b.positions[tb[2]]) == TriRelation::Crossing;
+            return tri_tri_relation(a.positions[ta[0]], a.positions[ta[1]], a.positions[ta[2]],
+                                    b.positions[tb[0]], b.positions[tb[1]],
+                                    b.positions[tb[2]]) == TriRelation::Crossing;
         });
     };
     bool want_crossing = false;
-    if (Result<Verdict> v0 = check(failing, options, context); v0) want_crossing = crossing_miss(failing, v0.value());
+    if (Result<Verdict> v0 = check(failing, options, context); v0)
+        want_crossing = crossing_miss(failing, v0.value());
     const auto same_failure = [&](const Frame& f, const Verdict& v) {
         return v.failed() && (!want_crossing || crossing_miss(f, v));
     };
@@ -639,7 +679,8 @@ Frame shrink(const Frame& failing, const RunOptions& options, FrameContext& cont
         for (std::size_t o = 0; o < cur.size(); ++o)
             for (std::size_t t = 0; t < cur[o].triangles.size(); ++t) all.emplace_back(o, t);
         const std::vector<std::size_t> keep = ddmin(
-            all.size(), [&](const std::vector<std::size_t>& idx) { return fails(keep_triangles(cur, all, idx)); },
+            all.size(),
+            [&](const std::vector<std::size_t>& idx) { return fails(keep_triangles(cur, all, idx)); },
             out_of_budget);
         // ddmin returns a failing subset, or all of them; keep_triangles also drops unused vertices,
         // which is kept for a full set only when the frame still fails (and nothing stopped).
@@ -708,12 +749,18 @@ Frame shrink(const Frame& failing, const RunOptions& options, FrameContext& cont
 
 const char* to_string(Reason r) {
     switch (r) {
-        case Reason::DepthQuantization: return "depth-quantization";
-        case Reason::PixelTie: return "pixel-tie";
-        case Reason::SubPixel: return "sub-pixel";
-        case Reason::EdgeOn: return "edge-on";
-        case Reason::Touching: return "touching";
-        case Reason::Unclassified: return "unclassified";
+        case Reason::DepthQuantization:
+            return "depth-quantization";
+        case Reason::PixelTie:
+            return "pixel-tie";
+        case Reason::SubPixel:
+            return "sub-pixel";
+        case Reason::EdgeOn:
+            return "edge-on";
+        case Reason::Touching:
+            return "touching";
+        case Reason::Unclassified:
+            return "unclassified";
     }
     return "?";
 }
@@ -725,7 +772,8 @@ bool edge_on(const Mesh& m, std::size_t t, int axis) {
 
 Result<Reason> classify(std::span<const Mesh> objects, const Verdict& verdict, const RunOptions& options,
                         FrameContext& context) {
-    if (!verdict.extra.empty() || verdict.missed.empty() || options.method == Method::Exact) return Reason::Unclassified;
+    if (!verdict.extra.empty() || verdict.missed.empty() || options.method == Method::Exact)
+        return Reason::Unclassified;
     const int res = options.resolution == 0 ? default_resolution(options.method) : options.resolution;
     const auto caught = [&](const RunOptions& o) -> Result<bool> {
         Result<Verdict> v = check(objects, o, context);
@@ -754,20 +802,24 @@ Result<Reason> classify(std::span<const Mesh> objects, const Verdict& verdict, c
         if (!c) return c.error();
         if (c.value()) return Reason::SubPixel;
     }
-    const bool all_touching = std::all_of(verdict.missed.begin(), verdict.missed.end(), [&](const TrianglePair& p) {
-        const Mesh &a = objects[p.object_a], &b = objects[p.object_b];
-        const Tri &ta = a.triangles[p.triangle_a], &tb = b.triangles[p.triangle_b];
-        const TriRelation rel = tri_tri_relation(a.positions[ta[0]], a.positions[ta[1]], a.positions[ta[2]],
-                                                 b.positions[tb[0]], b.positions[tb[1]], b.positions[tb[2]]);
-        return rel == TriRelation::Touching || rel == TriRelation::CoplanarOverlap;
-    });
+    const bool all_touching =
+        std::all_of(verdict.missed.begin(), verdict.missed.end(), [&](const TrianglePair& p) {
+            const Mesh &a = objects[p.object_a], &b = objects[p.object_b];
+            const Tri &ta = a.triangles[p.triangle_a], &tb = b.triangles[p.triangle_b];
+            const TriRelation rel =
+                tri_tri_relation(a.positions[ta[0]], a.positions[ta[1]], a.positions[ta[2]],
+                                 b.positions[tb[0]], b.positions[tb[1]], b.positions[tb[2]]);
+            return rel == TriRelation::Touching || rel == TriRelation::CoplanarOverlap;
+        });
     if (all_touching) return Reason::Touching;
-    const bool all_edge_on = std::all_of(verdict.missed.begin(), verdict.missed.end(), [&](const TrianglePair& p) {
-        for (int axis = 0; axis < 3; ++axis)
-            if (edge_on(objects[p.object_a], p.triangle_a, axis) || edge_on(objects[p.object_b], p.triangle_b, axis))
-                return true;
-        return false;
-    });
+    const bool all_edge_on =
+        std::all_of(verdict.missed.begin(), verdict.missed.end(), [&](const TrianglePair& p) {
+            for (int axis = 0; axis < 3; ++axis)
+                if (edge_on(objects[p.object_a], p.triangle_a, axis) ||
+                    edge_on(objects[p.object_b], p.triangle_b, axis))
+                    return true;
+            return false;
+        });
     if (all_edge_on) return Reason::EdgeOn;
     return Reason::Unclassified;
 }

@@ -3,6 +3,8 @@
 // smaller frame that still misses through process_frame and through `cullide run` on the written OBJ
 // files, and classified; methods that never miss give no finding in the same budget; the command's
 // errors and output files.
+#include "cullide/hunt.h"
+
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -19,7 +21,6 @@
 
 #include "cli.h"
 #include "cullide/ground_truth.h"
-#include "cullide/hunt.h"
 #include "cullide/mesh_io.h"
 #include "cullide/pipeline.h"
 #include "cullide/scenes.h"
@@ -79,14 +80,16 @@ Frame planted_wall() {
         m.name = std::move(name);
         for (int i = 0; i < 8; ++i)
             m.positions.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
-        const std::uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+        const std::uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                       {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
         for (const auto& f : q) {
             m.triangles.push_back({f[0], f[1], f[2]});
             m.triangles.push_back({f[0], f[2], f[3]});
         }
         return m;
     };
-    return {wall, box("crosser", {-0.25, 0.1, 0.2}, {0.3, 0.45, 0.6}), box("far", {2, 2, 2}, {2.5, 2.5, 2.5})};
+    return {wall, box("crosser", {-0.25, 0.1, 0.2}, {0.3, 0.45, 0.6}),
+            box("far", {2, 2, 2}, {2.5, 2.5, 2.5})};
 }
 
 RunOptions gl_exact_cullide() {
@@ -131,7 +134,8 @@ TEST_CASE("every generator is a function of its seed and gives valid frames in t
         CHECK(digests.size() == 25);  // different seeds, different frames
     }
     CHECK_FALSE(hunt::parse_generator("teapot"));
-    CHECK(has(hunt::parse_generator("teapot").error().message, "unknown generator 'teapot' (valid: soup, coplanar"));
+    CHECK(has(hunt::parse_generator("teapot").error().message,
+              "unknown generator 'teapot' (valid: soup, coplanar"));
 }
 
 TEST_CASE("the planted edge-on miss is shrunk to a smaller frame that still misses, and classified edge-on") {
@@ -170,7 +174,8 @@ TEST_CASE("the planted edge-on miss is shrunk to a smaller frame that still miss
     }
     // A stop at once keeps the input, which still fails.
     hunt::ShrinkStats stopped;
-    const Frame same = hunt::shrink(planted, opt, context, [] { return true; }, 2000, &stopped);
+    const Frame same = hunt::shrink(
+        planted, opt, context, [] { return true; }, 2000, &stopped);
     CHECK(stopped.stopped);
     CHECK(cullide::frame_digest(same) == cullide::frame_digest(planted));
 }
@@ -181,7 +186,8 @@ TEST_CASE("boxes touching face to face are missed at any setting, and classified
         m.name = "box";
         for (int i = 0; i < 8; ++i)
             m.positions.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
-        const std::uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+        const std::uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                       {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
         for (const auto& f : q) {
             m.triangles.push_back({f[0], f[1], f[2]});
             m.triangles.push_back({f[0], f[2], f[3]});
@@ -210,7 +216,8 @@ TEST_CASE("classify names a depth-quantization miss and a sub-pixel miss by re-r
     cullide::FrameContext context;
     int named = 0;
     for (std::uint64_t seed = 0; seed < 60 && named < 8; ++seed) {
-        for (hunt::Generator g : {hunt::Generator::SubPixel, hunt::Generator::Coplanar, hunt::Generator::Sliver}) {
+        for (hunt::Generator g :
+             {hunt::Generator::SubPixel, hunt::Generator::Coplanar, hunt::Generator::Sliver}) {
             RunOptions opt = gl_exact_cullide();
             opt.depth_format = seed % 2 ? raster::DepthFormat::D16 : raster::DepthFormat::D24;
             const Frame f = hunt::generate(g, seed);
@@ -218,9 +225,12 @@ TEST_CASE("classify names a depth-quantization miss and a sub-pixel miss by re-r
             if (!v.failed()) continue;
             const hunt::Reason r = hunt::classify(f, v, opt, context).value();
             RunOptions again = opt;
-            if (r == hunt::Reason::DepthQuantization) again.depth_format = raster::DepthFormat::D32F;
-            else if (r == hunt::Reason::SubPixel) again.resolution = 4 * opt.resolution;
-            else continue;
+            if (r == hunt::Reason::DepthQuantization)
+                again.depth_format = raster::DepthFormat::D32F;
+            else if (r == hunt::Reason::SubPixel)
+                again.resolution = 4 * opt.resolution;
+            else
+                continue;
             ++named;
             CAPTURE(hunt::to_string(r));
             CHECK_FALSE(hunt::check(f, again, context).value().failed());
@@ -233,7 +243,8 @@ TEST_CASE("methods that never miss give no finding in the budget where cullide f
     cullide::FrameContext context;
     const std::uint64_t cases = 24;
     int cullide_failures = 0;
-    for (Method m : {Method::Exact, Method::RCullide, Method::RCullideOffset, Method::QCullide, Method::Cullide}) {
+    for (Method m :
+         {Method::Exact, Method::RCullide, Method::RCullideOffset, Method::QCullide, Method::Cullide}) {
         RunOptions opt = gl_exact_cullide();
         opt.method = m;
         CAPTURE(cullide::to_string(m));
@@ -253,7 +264,8 @@ TEST_CASE("methods that never miss give no finding in the budget where cullide f
 
     // The same through the command: a finding is exit status 1 for a never-miss method.
     const fs::path dir = temp_dir("never");
-    const Outcome r = cli({"hunt", "--method", "rcullide", "--resolution", "64", "--cases", "24", "--out", dir.string()});
+    const Outcome r =
+        cli({"hunt", "--method", "rcullide", "--resolution", "64", "--cases", "24", "--out", dir.string()});
     CHECK(r.status == 0);
     CHECK(has(r.out, "24 cases"));
     CHECK(has(r.out, "0 findings"));
@@ -263,9 +275,9 @@ TEST_CASE("methods that never miss give no finding in the budget where cullide f
 
 TEST_CASE("cullide hunt writes each finding, and its run command reproduces the miss") {
     const fs::path dir = temp_dir("findings");
-    const std::vector<std::string> args{"hunt", "--method", "cullide", "--resolution", "64", "--generators",
-                                        "edge-on,room", "--cases", "6", "--max-findings", "2", "--seed", "7",
-                                        "--out", dir.string()};
+    const std::vector<std::string> args{
+        "hunt", "--method",       "cullide", "--resolution", "64", "--generators", "edge-on,room", "--cases",
+        "6",    "--max-findings", "2",       "--seed",       "7",  "--out",        dir.string()};
     fs::create_directories(dir / "finding-001");
     std::ofstream(dir / "finding-001" / "object_9.obj") << "# left by an earlier hunt\n";
     const Outcome r = cli(args);
@@ -329,9 +341,9 @@ TEST_CASE("cullide hunt perturbs mesh files and built-in scenes") {
     const fs::path a = dir / "wall.obj", b = dir / "crosser.obj";
     std::ofstream(a) << cullide::write_obj({planted[0]});
     std::ofstream(b) << cullide::write_obj({planted[1]});
-    const Outcome r = cli({"hunt", "--method", "cullide", "--resolution", "64", "--mesh", a.string(), "--mesh",
-                           b.string(), "--scene", "cylinders", "--scale", "0.05", "--cases", "4", "--out",
-                           (dir / "out").string(), "--json", "-"});
+    const Outcome r = cli({"hunt", "--method", "cullide", "--resolution", "64", "--mesh", a.string(),
+                           "--mesh", b.string(), "--scene", "cylinders", "--scale", "0.05", "--cases", "4",
+                           "--out", (dir / "out").string(), "--json", "-"});
     REQUIRE(r.status == 0);
     CHECK(has(r.out, "\"name\": \"mesh:" + a.string() + "+" + b.string() + "\", \"cases\": 2"));
     CHECK(has(r.out, "\"name\": \"scene:cylinders\", \"cases\": 2"));
@@ -347,9 +359,9 @@ TEST_CASE("cullide hunt perturbs mesh files and built-in scenes") {
     std::istringstream row(rows[1]);
     for (std::string c; std::getline(row, c, ',');) cells.push_back(c);
     REQUIRE(cells.size() > 9);
-    CHECK(cells[6] == "14");                  // triangles_before
-    CHECK(std::stoi(cells[8]) < 14);          // triangles after shrinking
-    CHECK(std::stoi(cells[9]) > 0);           // missed pairs
+    CHECK(cells[6] == "14");          // triangles_before
+    CHECK(std::stoi(cells[8]) < 14);  // triangles after shrinking
+    CHECK(std::stoi(cells[9]) > 0);   // missed pairs
     fs::remove_all(dir);
 }
 
@@ -365,8 +377,8 @@ TEST_CASE("Ctrl-C stops a hunt at the next frame and still writes the summary") 
         std::this_thread::sleep_for(std::chrono::milliseconds(300));
         std::raise(SIGINT);
     });
-    const Outcome r = cli({"hunt", "--method", "cullide", "--generators", "room", "--budget-s", "120", "--out",
-                           dir.string()});
+    const Outcome r = cli({"hunt", "--method", "cullide", "--resolution", "64", "--generators", "room",
+                           "--budget-s", "120", "--out", dir.string()});
     interrupter.join();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::signal(SIGINT, previous);

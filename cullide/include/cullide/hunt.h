@@ -30,17 +30,17 @@
 
 namespace cullide::hunt {
 
-// The built-in soup generators. Each makes a small frame (2-10 objects, up to a few dozen
-// triangles) around the unit cube, from one 64-bit seed.
+// The built-in generators. Each makes a small frame (2-9 objects, at most about 150 triangles)
+// around the unit cube, from one 64-bit seed.
 enum class Generator {
-    Soup,       // random triangles, on a coarse grid or raw doubles
-    Coplanar,   // triangles in one plane, or a tiny distance apart (near-coplanar contact)
-    Grazing,    // a vertex or an edge exactly on another triangle (touching, no crossing)
-    SubPixel,   // a triangle poking through another by 1e-7..1e-3 of the scene
-    EdgeOn,     // an axis-aligned wall (seen edge-on in two axis views) crossed by a small solid
-    Sliver,     // needle and cap triangles crossing ordinary ones
-    Extreme,    // a soup scaled by 2^k (|k| up to 200) or moved by up to 1e6
-    Room,       // a box room of six wall objects, and solids crossing its walls
+    Soup,      // random triangles, on a coarse grid or raw doubles
+    Coplanar,  // triangles in one plane, or a tiny distance apart (near-coplanar contact)
+    Grazing,   // a vertex or an edge exactly on another triangle (touching, no crossing)
+    SubPixel,  // a sheet (often tilted off every axis plane) poked through by 2^-7..2^-24
+    EdgeOn,    // an axis-aligned wall (seen edge-on in two axis views) crossed by a small solid
+    Sliver,    // needle and cap triangles crossing ordinary ones
+    Extreme,   // a soup scaled by 2^k (|k| up to 200) or moved by up to 1e6
+    Room,      // a box room of six wall objects, and solids crossing its walls
 };
 
 [[nodiscard]] const char* to_string(Generator g);
@@ -68,7 +68,8 @@ struct Verdict {
 
 // One frame through `options` (process_frame) and the ground truth (exact_pairs, with options.self).
 // Fails when either refuses the frame.
-[[nodiscard]] Result<Verdict> check(std::span<const Mesh> objects, const RunOptions& options, FrameContext& context);
+[[nodiscard]] Result<Verdict> check(std::span<const Mesh> objects, const RunOptions& options,
+                                    FrameContext& context);
 
 // Asked between checks; true stops the search or the shrinking at once (Ctrl-C, a time budget).
 using StopFn = std::function<bool()>;
@@ -90,8 +91,8 @@ enum class Reason {
 [[nodiscard]] const char* to_string(Reason r);
 
 struct ShrinkStats {
-    std::uint64_t checks = 0;            // frames run while shrinking (a classification counts 4)
-    bool stopped = false;                // the stop function or the check limit ended it early
+    std::uint64_t checks = 0;              // frames run while shrinking (a classification counts 4)
+    bool stopped = false;                  // the stop function or the check limit ended it early
     Reason reason = Reason::Unclassified;  // classify's reason after the object and triangle stages
 };
 
@@ -106,10 +107,10 @@ struct ShrinkStats {
 [[nodiscard]] Frame shrink(const Frame& failing, const RunOptions& options, FrameContext& context,
                            const StopFn& stop, std::uint64_t max_checks, ShrinkStats* stats = nullptr);
 
-
-// The reason of `verdict` (which must come from check(objects, options)). Runs at most four frames.
-[[nodiscard]] Result<Reason> classify(std::span<const Mesh> objects, const Verdict& verdict, const RunOptions& options,
-                                      FrameContext& context);
+// The reason of `verdict` (which must come from check(objects, options)). Runs at most four frames;
+// Touching and EdgeOn are then decided on the geometry.
+[[nodiscard]] Result<Reason> classify(std::span<const Mesh> objects, const Verdict& verdict,
+                                      const RunOptions& options, FrameContext& context);
 
 // True when triangle t of m has zero area seen along `axis` (0 = x, 1 = y, 2 = z), exactly.
 [[nodiscard]] bool edge_on(const Mesh& m, std::size_t t, int axis);
