@@ -13,6 +13,7 @@
 
 #include "bench.h"
 #include "help.h"
+#include "hunt.h"
 #include "options.h"
 #include "cullide/mesh_io.h"
 #include "cullide/pipeline.h"
@@ -251,14 +252,14 @@ int help_command(const std::vector<std::string>& args, std::ostream& out) {
         return 0;
     }
     if (args.size() == 2) {
-        for (Command c : {Command::Run, Command::Bench, Command::Sweep}) {
+        for (Command c : kCommandList) {
             if (args[1] == command_name(c)) {
                 out << command_help(c);
                 return 0;
             }
         }
     }
-    throw UsageError{"help takes one command name (run, bench, sweep) or --man (got '" + args[1] + "')"};
+    throw UsageError{"help takes one command name (run, bench, sweep, hunt) or --man (got '" + args[1] + "')"};
 }
 
 int scenes_command(const std::vector<std::string>& args, std::ostream& out) {
@@ -290,6 +291,7 @@ int run(const std::vector<std::string>& args, std::ostream& out, std::ostream& e
         if (command == "version" || command == "--version") return version_command(args, out);
         if (command == "scenes") return scenes_command(args, out);
         if (command == "bench" || command == "sweep") return bench_command(args, out, err);
+        if (command == "hunt") return hunt_command(args, out, err);
         if (command == "run") {
             try {
                 return run_command(args, out, err);

@@ -52,6 +52,18 @@ constexpr const char* kSweepDescription =
     "qcullide) but misses is marked MISMATCH and the exit status is 1. The options are those of bench, with "
     "the sweep's own defaults; a progress bar goes to stderr when it is a terminal.";
 
+constexpr const char* kHuntDescription =
+    "Searches for frames where a method misses a true colliding pair (for a method that never misses: any "
+    "difference from the ground truth) and shrinks each finding to a small reproduction. Frames come from "
+    "built-in generators of adversarial triangle soups (--generators), from perturbations of mesh files "
+    "(--mesh) and of built-in scene frames (--scene), all deterministic from --seed. A finding is shrunk "
+    "by delta debugging over objects, then triangles, then by simplifying coordinates while it still "
+    "misses, and its reason is named by re-running it with one setting changed (docs/hunt.md). Each "
+    "finding gets a folder in --out: one OBJ file per object, command.txt (a 'cullide run' line that "
+    "reproduces it), pairs.csv (the missed pairs) and the reason; summary.csv and summary.json list them "
+    "all. The search stops at --budget-s, --cases or Ctrl-C, writing what was found; it prints, per source, how many frames failed and how many true pairs were missed. Exit "
+    "status 1 when a method that never misses has a finding.";
+
 const std::vector<CommandDoc>& command_docs() {
     static const std::vector<CommandDoc> docs{
         {"run", "[SCENE...] [options]", "detect colliding triangle pairs, frame by frame", kRunDescription},
@@ -59,6 +71,7 @@ const std::vector<CommandDoc>& command_docs() {
         {"bench", "[options]", "time methods per frame, checked against the ground truth", kBenchDescription},
         {"sweep", "[options]", "resolution x depth format x method x scene: time, PCS, errors",
          kSweepDescription},
+        {"hunt", "[options]", "search for frames a method gets wrong, and shrink them", kHuntDescription},
         {"help", "[COMMAND] [--man]", "this text, or one command's; --man: the manual page (roff)",
          "Prints every command and option; 'cullide help COMMAND' is 'cullide COMMAND --help'; 'cullide help "
          "--man' prints this manual page as roff."},

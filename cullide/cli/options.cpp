@@ -1,4 +1,4 @@
-// cullide/cli/options.cpp: the option table of run, bench and sweep, and the parser that reads it.
+// cullide/cli/options.cpp: the option table of run, bench, sweep and hunt, and the parser that reads it.
 #include "options.h"
 
 #include <algorithm>
@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string_view>
 
+#include "cullide/hunt.h"
 #include "raster/types.h"
 
 namespace cullide::cli {
@@ -165,7 +166,7 @@ void add_shared_options(std::vector<OptionSpec>& t) {
     t.push_back({"--seed",
                  "S",
                  kAllCommands,
-                 "scene seed, an unsigned 64-bit integer",
+                 "scene seed, an unsigned 64-bit integer (hunt: the seed of the whole search)",
                  {},
                  std::to_string(SceneOptions{}.seed),
                  "",
@@ -190,7 +191,7 @@ void add_run_options(std::vector<OptionSpec>& t) {
     t.push_back(
         {"--method",
          "M",
-         kRunOnly,
+         kRunHunt,
          "rcullide (R-CULLIDE, exact-bounds conservative raster: never misses), exact (the ground truth), "
          "cullide (GL-exact visibility culling, may miss collisions like the GPU original), rcullide-offset "
          "(R-CULLIDE with the paper's offset solids: never misses), qcullide (Quick-CULLIDE, exact-bounds: "
@@ -205,19 +206,19 @@ void add_run_options(std::vector<OptionSpec>& t) {
     t.push_back({"--frames", "N", kRunOnly, "frames to run", integers(1, 1000000),
                  "10 for built-in scenes, 1 for files", "",
                  [](const OptionSpec& o, const std::string& v, Settings& s) { s.frames = int_value(o, v); }});
-    t.push_back({"--threads", "T", kRunOnly, "worker threads, 0 = all cores; results do not depend on it",
+    t.push_back({"--threads", "T", kRunHunt, "worker threads, 0 = all cores; results do not depend on it",
                  integers(0, kMaxThreads), std::to_string(d.threads), "",
                  [](const OptionSpec& o, const std::string& v, Settings& s) {
                      s.pipeline.threads = int_value(o, v);
                  }});
-    t.push_back({"--resolution", "R", kRunOnly, "view resolution of visibility methods",
+    t.push_back({"--resolution", "R", kRunHunt, "view resolution of visibility methods",
                  integers(kMinCliResolution, kMaxViewResolution), resolution_default(), "",
                  [](const OptionSpec& o, const std::string& v, Settings& s) {
                      s.pipeline.resolution = int_value(o, v);
                  }});
     t.push_back({"--depth-format",
                  "F",
-                 kRunOnly,
+                 kRunHunt,
                  "depth buffer of visibility methods: d16, d24, d32f",
                  {},
                  to_string(d.depth_format),
@@ -225,7 +226,7 @@ void add_run_options(std::vector<OptionSpec>& t) {
                  [](const OptionSpec& o, const std::string& v, Settings& s) {
                      s.pipeline.depth_format = checked(o, parse_depth_format(v));
                  }});
-    t.push_back({"--scale", "X", kRunOnly, "scene size factor", reals(0, true, kMaxSceneScale, false), "1",
+    t.push_back({"--scale", "X", kRunHunt, "scene size factor", reals(0, true, kMaxSceneScale, false), "1",
                  "", [](const OptionSpec& o, const std::string& v, Settings& s) {
                      s.scene.scale = real_value(o, v, false);
                  }});
@@ -363,7 +364,7 @@ void add_bench_options(std::vector<OptionSpec>& t) {
                  [](const OptionSpec&, const std::string& v, Settings& s) { s.json_path = v; }});
     t.push_back({"--no-progress",
                  "",
-                 kBenchSweep,
+                 kBenchSweep | kHuntOnly,
                  "no progress bar (it is drawn on stderr only when stderr is a terminal)",
                  {},
                  "",
@@ -371,11 +372,107 @@ void add_bench_options(std::vector<OptionSpec>& t) {
                  [](const OptionSpec&, const std::string&, Settings& s) { s.progress = false; }});
 }
 
+void add_hunt_options(std::vector<OptionSpec>& t) {
+    t.push_back({"--generators",
+                 "LIST",
+                 kHuntOnly,
+                 "frame generators: " + joined(hunt::generator_names()) +
+                     "; 'all' = every one (docs/hunt.md says what each makes)",
+                 {},
+                 "all, or none when --mesh or --scene is given",
+                 "",
+                 [](const OptionSpec& o, const std::string& v, Settings& s) {
+                     s.generators.clear();
+                     for (const std::string& item : list_items(o, v)) {
+                         if (item == "all") {
+                             const std::vector<std::string> all = hunt::generator_names();
+                             s.generators.insert(s.generators.end(), all.begin(), all.end());
+                         } else {
+                             (void)checked(o, hunt::parse_generator(item));
+                             s.generators.push_back(item);
+                         }
+                     }
+                 }});
+    t.push_back({"--mesh",
+                 "FILE",
+                 kHuntOnly,
+                 "also hunt perturbations of the frame made of these mesh files (.obj .ply .stl); repeat for "
+                 "more files",
+                 {},
+                 "",
+                 "",
+                 [](const OptionSpec&, const std::string& v, Settings& s) { s.mesh_files.push_back(v); }});
+    t.push_back({"--scene",
+                 "NAME",
+                 kHuntOnly,
+                 "also hunt perturbations of frames of this built-in scene; repeat for more scenes",
+                 {},
+                 "",
+                 "",
+                 [](const OptionSpec& o, const std::string& v, Settings& s) {
+                     const std::vector<std::string> names = scene_names();
+                     if (std::find(names.begin(), names.end(), v) == names.end())
+                         throw UsageError{o.name + ": unknown scene '" + v + "' (valid: " + joined(names) +
+                                          ")"};
+                     s.hunt_scenes.push_back(v);
+                 }});
+    t.push_back({"--budget-s", "S", kHuntOnly,
+                 "stop after S seconds of searching (Ctrl-C also stops, keeping what was found)",
+                 reals(0, true, 604800, false), "30 when --cases is not given", "",
+                 [](const OptionSpec& o, const std::string& v, Settings& s) {
+                     s.budget_s = real_value(o, v, false);
+                 }});
+    t.push_back({"--cases", "N", kHuntOnly, "stop after N generated frames", integers(1, 1000000000),
+                 "no limit", "", [](const OptionSpec& o, const std::string& v, Settings& s) {
+                     s.cases = static_cast<std::uint64_t>(int_value(o, v));
+                 }});
+    t.push_back({"--max-findings", "N", kHuntOnly,
+                 "shrink and write the first N findings; later failing frames are only counted",
+                 integers(1, 100000), "10", "", [](const OptionSpec& o, const std::string& v, Settings& s) {
+                     s.max_findings = int_value(o, v);
+                 }});
+    t.push_back({"--shrink-checks", "N", kHuntOnly, "at most N frames run to shrink one finding",
+                 integers(0, 100000000), "2000", "",
+                 [](const OptionSpec& o, const std::string& v, Settings& s) {
+                     s.shrink_checks = static_cast<std::uint64_t>(int_value(o, v));
+                 }});
+    t.push_back(
+        {"--out",
+         "DIR",
+         kHuntOnly,
+         "where findings are written, one folder each (OBJ files, the run command, the missed pairs), "
+         "with summary.csv and summary.json",
+         {},
+         "hunt-out",
+         "",
+         [](const OptionSpec&, const std::string& v, Settings& s) {
+             if (v.empty()) throw UsageError{"--out needs a folder name"};
+             s.out_dir = v;
+         }});
+    t.push_back({"--csv",
+                 "FILE",
+                 kHuntOnly,
+                 "also write the summary, one CSV row per finding ('-' = stdout)",
+                 {},
+                 "",
+                 "",
+                 [](const OptionSpec&, const std::string& v, Settings& s) { s.csv_path = v; }});
+    t.push_back({"--json",
+                 "FILE",
+                 kHuntOnly,
+                 "also write the summary as a JSON document ('-' = stdout)",
+                 {},
+                 "",
+                 "",
+                 [](const OptionSpec&, const std::string& v, Settings& s) { s.json_path = v; }});
+}
+
 std::vector<OptionSpec> make_table() {
     std::vector<OptionSpec> t;
     add_run_options(t);
     add_shared_options(t);
     add_bench_options(t);
+    add_hunt_options(t);
     return t;
 }
 
@@ -399,13 +496,15 @@ const char* command_name(Command c) {
             return "bench";
         case Command::Sweep:
             return "sweep";
+        case Command::Hunt:
+            return "hunt";
     }
     return "?";
 }
 
 std::string command_list(CommandSet set) {
     std::vector<std::string> names;
-    for (Command c : {Command::Run, Command::Bench, Command::Sweep}) {
+    for (Command c : kCommandList) {
         if (takes(set, c)) names.emplace_back(command_name(c));
     }
     std::string s;
@@ -465,7 +564,10 @@ Settings parse_options(Command command, const std::vector<std::string>& args) {
                 s.inputs.push_back(a);
                 continue;
             }
-            throw UsageError{"unknown option '" + a + "' (scenes are given with --scenes)"};
+            const char* where = command == Command::Hunt
+                                    ? " (mesh files are given with --mesh, scenes with --scene)"
+                                    : " (scenes are given with --scenes)";
+            throw UsageError{"unknown option '" + a + "'" + where};
         }
         const auto spec = std::find_if(table.begin(), table.end(), [&](const OptionSpec& o) {
             return o.name == a && takes(o.commands, command);

@@ -1,4 +1,4 @@
-// cullide/cli/options.h: the one table of command-line options of `run`, `bench` and `sweep`.
+// cullide/cli/options.h: the one table of command-line options of `run`, `bench`, `sweep` and `hunt`.
 //
 // Each option is one OptionSpec: name, value placeholder, help line, range, default, the commands
 // that take it and how it sets Settings. Parsing, range checks and error messages come from the
@@ -16,12 +16,18 @@
 namespace cullide::cli {
 
 // The commands that take options. Bits, so one option can name every command that takes it.
-enum class Command : unsigned { Run = 1u, Bench = 2u, Sweep = 4u };
+enum class Command : unsigned { Run = 1u, Bench = 2u, Sweep = 4u, Hunt = 8u };
 using CommandSet = unsigned;
 inline constexpr CommandSet kRunOnly = static_cast<unsigned>(Command::Run);
+inline constexpr CommandSet kHuntOnly = static_cast<unsigned>(Command::Hunt);
+// The options that set one frame's pipeline (method, resolution, depth format, threads): run and
+// hunt take one value each, bench and sweep lists of their own.
+inline constexpr CommandSet kRunHunt = kRunOnly | kHuntOnly;
 inline constexpr CommandSet kBenchSweep =
     static_cast<unsigned>(Command::Bench) | static_cast<unsigned>(Command::Sweep);
-inline constexpr CommandSet kAllCommands = kRunOnly | kBenchSweep;
+inline constexpr CommandSet kAllCommands = kRunOnly | kBenchSweep | kHuntOnly;
+// Every command, in help order.
+inline constexpr Command kCommandList[] = {Command::Run, Command::Bench, Command::Sweep, Command::Hunt};
 
 [[nodiscard]] inline bool takes(CommandSet set, Command c) { return (set & static_cast<unsigned>(c)) != 0; }
 [[nodiscard]] const char* command_name(Command c);
@@ -58,8 +64,17 @@ struct Settings {
     int first_frame = 0;
     int frame_step = 1;
     std::optional<int> warmup, reps;
-    std::string csv_path, json_path;
+    std::string csv_path, json_path;  // also hunt's summary copies
     bool progress = true;
+    // hunt (cullide/hunt.h); generator names are checked by the option
+    std::vector<std::string> generators;  // empty: every generator, unless --mesh or --scene is given
+    std::vector<std::string> mesh_files;  // --mesh, repeatable: one frame of all of them
+    std::vector<std::string> hunt_scenes;  // --scene, repeatable
+    std::optional<double> budget_s;
+    std::optional<std::uint64_t> cases;
+    int max_findings = 10;
+    std::uint64_t shrink_checks = 2000;
+    std::string out_dir = "hunt-out";
 };
 
 struct OptionSpec;

@@ -39,7 +39,7 @@ std::string one_line(const std::string& s) { return std::regex_replace(s, std::r
 
 std::string roff_name(std::string name) { return std::regex_replace(name, std::regex("-"), "\\-"); }
 
-const std::vector<Command> kCommands{Command::Run, Command::Bench, Command::Sweep};
+const std::vector<Command> kCommands{Command::Run, Command::Bench, Command::Sweep, Command::Hunt};
 
 }  // namespace
 
@@ -70,8 +70,10 @@ TEST_CASE("each command refuses the options it does not take, naming the command
     for (const OptionSpec& o : cullide::cli::option_table()) {
         for (Command c : kCommands) {
             bool taken = false;  // a same-named option of c (run's --threads T, bench's --threads LIST)
+            cullide::cli::CommandSet takers = 0;  // every command taking an option of this name
             for (const OptionSpec& other : cullide::cli::option_table()) {
                 taken = taken || (other.name == o.name && cullide::cli::takes(other.commands, c));
+                if (other.name == o.name) takers |= other.commands;
             }
             if (taken) continue;
             const std::string command = cullide::cli::command_name(c);
@@ -79,13 +81,13 @@ TEST_CASE("each command refuses the options it does not take, naming the command
             CAPTURE(o.name);
             const Outcome r = run({command, o.name, "1"});
             CHECK(r.status == 2);
-            CHECK(has(r.err, "option " + o.name + " is taken by " + cullide::cli::command_list(o.commands) +
+            CHECK(has(r.err, "option " + o.name + " is taken by " + cullide::cli::command_list(takers) +
                                  ", not by " + command));
             CHECK(has(r.err, "cullide " + command + " --help"));
             CHECK(r.out.empty());
         }
     }
-    CHECK(has(run({"run", "--csv", "x.csv"}).err, "option --csv is taken by bench and sweep, not by run"));
+    CHECK(has(run({"run", "--csv", "x.csv"}).err, "option --csv is taken by bench, sweep and hunt, not by run"));
     CHECK(has(run({"sweep", "--pairs", "p.csv"}).err, "option --pairs is taken by run, not by sweep"));
     CHECK(has(run({"scenes", "--frames", "2"}).err, "scenes takes no options"));
 }
@@ -135,20 +137,21 @@ TEST_CASE("help is generated per command: sweep prints its own defaults, help CO
     CHECK(has(bench, "default exact,cullide,rcullide"));
     CHECK_FALSE(has(bench, "--pairs"));
     CHECK_FALSE(has(run({"run", "--help"}).out, "--csv"));
-    for (const char* c : {"run", "bench", "sweep"}) {
+    for (const char* c : {"run", "bench", "sweep", "hunt"}) {
         CAPTURE(c);
         CHECK(run({"help", c}).out == run({c, "--help"}).out);
     }
     const Outcome bad = run({"help", "frobnicate"});
     CHECK(bad.status == 2);
-    CHECK(has(bad.err, "help takes one command name (run, bench, sweep) or --man (got 'frobnicate')"));
+    CHECK(has(bad.err, "help takes one command name (run, bench, sweep, hunt) or --man (got 'frobnicate')"));
 }
 
 TEST_CASE("the man page is man(7) roff: a title, the sections, and no line a formatter would misread") {
     const std::string man = run({"help", "--man"}).out;
     for (const char* section : {".SH NAME", ".SH SYNOPSIS", ".SH DESCRIPTION", ".SH COMMANDS", ".SH OPTIONS",
-                                ".SS \"Options of run\"", ".SS \"Options of run, bench and sweep\"",
-                                ".SS \"Options of bench and sweep\"", ".SH \"EXIT STATUS\""}) {
+                                ".SS \"Options of run\"",
+                                ".SS \"Options of bench and sweep\"", ".SS \"Options of run and hunt\"",
+                                ".SS \"Options of run, bench, sweep and hunt\"", ".SS \"Options of hunt\"", ".SH \"EXIT STATUS\""}) {
         CAPTURE(section);
         CHECK(has(man, std::string("\n") + section + "\n"));
     }
