@@ -44,6 +44,7 @@ struct FrontEndParams {
     Viewport viewport;
     CullFace cull_face;
     FrontFace front_face;
+    RasterRules rules = RasterRules::GlLlvmpipe;  // GL-exact setup only (exact bounds ignore it)
 };
 
 // Runs clipping and setup for one input triangle (clip-space vertices a, b, c), appending 0..n
