@@ -439,6 +439,8 @@ void VulkanDevice::clear(double depth) {
 
 raster::Result<raster::QueryResults> VulkanDevice::run(const raster::CommandBatch& batch) {
     Impl& g = *impl_;
+    if (batch.rules() != raster::RasterRules::Vulkan)
+        return raster::Error{"vulkan device: the batch is recorded for the GL rules (clip z in [-w, w])"};
     // One vertex and one index buffer for the whole batch, each draw at its base vertex; draws over
     // the same vertex span share one copy (as the OSMesa device does).
     std::vector<raster::Float4> verts;

@@ -30,7 +30,7 @@ class VulkanDevice {
 
     // vkCmdClearDepthStencilImage with depth (as a float).
     void clear(double depth);
-    // Records every command in one render pass (viewport, cull mode, front face, compare op and
+    // Fails unless the batch is recorded for RasterRules::Vulkan. Records every command in one render pass (viewport, cull mode, front face, compare op and
     // write enable as dynamic state; each query begun with VK_QUERY_CONTROL_PRECISE_BIT), submits,
     // waits, and returns the query results indexed like the batch's queries (any-samples queries:
     // count > 0). Cull and front face use Vulkan's names for the DrawState values: FrontFace::CCW is
