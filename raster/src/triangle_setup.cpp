@@ -62,13 +62,14 @@ const float* clip_plane(const RuleSet& r, int plane) {
 }
 
 // The clip mask bits, as the vertex shader computes them (same plane order).
-unsigned clip_mask(const RuleSet& r, const float* p) {
+template <bool HalfZ>
+unsigned clip_mask(const float* p) {
     unsigned m = 0;
     if (p[0] > p[3]) m |= 1u;
     if (0.0f > p[0] + p[3]) m |= 2u;
     if (p[1] > p[3]) m |= 4u;
     if (0.0f > p[1] + p[3]) m |= 8u;
-    if (r.half_z ? 0.0f > p[2] : 0.0f > p[2] + p[3]) m |= 16u;
+    if (HalfZ ? 0.0f > p[2] : 0.0f > p[2] + p[3]) m |= 16u;
     if (p[2] > p[3]) m |= 32u;
     return m;
 }
@@ -115,9 +116,12 @@ ClipVertex interpolate(const ViewportXform& xf, float t, const ClipVertex& out, 
     return d;
 }
 
-// llvmpipe's setup of one (post-clip) triangle in window coordinates.
-void setup_window_triangle(const FrontEndParams& p, const RuleSet& rules, const ClipVertex* v0, const ClipVertex* v1,
-                           const ClipVertex* v2, std::uint32_t draw, std::vector<SetupTri>& out) {
+// llvmpipe's setup of one (post-clip) triangle in window coordinates. A template on the rules, so
+// each rule set's front end is compiled with its choices as constants (the GL path is as it was).
+template <RasterRules Rules>
+void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const ClipVertex* v1, const ClipVertex* v2,
+                           std::uint32_t draw, std::vector<SetupTri>& out) {
+    constexpr RuleSet rules = rule_set(Rules);
     // Snap to 16.8 after moving the pixel centre to the integer lattice (round half to even, as
     // cvtps2dq does in the default rounding mode).
     auto snap = [](float w) { return static_cast<int64_t>(std::lrint((w - 0.5f) * kFixedOne)); };
@@ -205,17 +209,18 @@ void setup_window_triangle(const FrontEndParams& p, const RuleSet& rules, const 
 
 }  // namespace
 
-void setup_triangle(const FrontEndParams& params, const Float4& a, const Float4& b, const Float4& c,
-                    std::uint32_t draw, std::vector<SetupTri>& out) {
-    const RuleSet rules = rule_set(params.rules);
+template <RasterRules Rules>
+void setup_triangle_for(const FrontEndParams& params, const Float4& a, const Float4& b, const Float4& c,
+                        std::uint32_t draw, std::vector<SetupTri>& out) {
+    constexpr RuleSet rules = rule_set(Rules);
     const ViewportXform xf = make_xform(rules, params.viewport);
     ClipVertex in[3] = {{{a.x, a.y, a.z, a.w}, {}}, {{b.x, b.y, b.z, b.w}, {}}, {{c.x, c.y, c.z, c.w}, {}}};
     unsigned m[3];
-    for (int i = 0; i < 3; ++i) m[i] = clip_mask(rules, in[i].clip);
+    for (int i = 0; i < 3; ++i) m[i] = clip_mask<rules.half_z>(in[i].clip);
     if ((m[0] & m[1] & m[2]) != 0) return;  // wholly outside one plane
     for (auto& v : in) shader_viewport(xf, v);
     if ((m[0] | m[1] | m[2]) == 0) {
-        setup_window_triangle(params, rules, &in[0], &in[1], &in[2], draw, out);
+        setup_window_triangle<Rules>(params, &in[0], &in[1], &in[2], draw, out);
         return;
     }
 
@@ -278,11 +283,16 @@ void setup_triangle(const FrontEndParams& params, const Float4& a, const Float4&
     // the provoking vertex is the first (draw_pipe_clip.c's emit_poly).
     for (int i = 2; i < n; ++i) {
         if (rules.provoking_first)
-            setup_window_triangle(params, rules, inlist[0], inlist[i - 1], inlist[i], draw, out);
+            setup_window_triangle<Rules>(params, inlist[0], inlist[i - 1], inlist[i], draw, out);
         else
-            setup_window_triangle(params, rules, inlist[i - 1], inlist[i], inlist[0], draw, out);
+            setup_window_triangle<Rules>(params, inlist[i - 1], inlist[i], inlist[0], draw, out);
     }
 }
+
+template void setup_triangle_for<RasterRules::GlLlvmpipe>(const FrontEndParams&, const Float4&, const Float4&,
+                                                          const Float4&, std::uint32_t, std::vector<SetupTri>&);
+template void setup_triangle_for<RasterRules::Vulkan>(const FrontEndParams&, const Float4&, const Float4&,
+                                                      const Float4&, std::uint32_t, std::vector<SetupTri>&);
 
 }  // namespace raster::detail
 

@@ -262,6 +262,10 @@ raster::Result<std::unique_ptr<VulkanDevice>> VulkanDevice::create(int width, in
     if (!is_depth_attachment(g.physical, g.format))
         return raster::Error{"vulkan device: the depth format cannot be a depth attachment"};
     const bool has_stencil = g.format == VK_FORMAT_D24_UNORM_S8_UINT;
+    g.name.append(g.format == VK_FORMAT_D16_UNORM              ? ", D16_UNORM"
+                  : g.format == VK_FORMAT_X8_D24_UNORM_PACK32 ? ", X8_D24_UNORM_PACK32"
+                  : has_stencil                               ? ", D24_UNORM_S8_UINT"
+                                                              : ", D32_SFLOAT");
     VkImageAspectFlags aspects = VK_IMAGE_ASPECT_DEPTH_BIT;
     if (has_stencil) aspects |= VK_IMAGE_ASPECT_STENCIL_BIT;
 

@@ -39,6 +39,7 @@ class VulkanDevice {
     // The depth image, row 0 = framebuffer y 0, in raster::DepthTarget's encoding.
     [[nodiscard]] std::vector<std::uint32_t> read_depth();
 
+    // "llvmpipe (LLVM ...), Mesa 22.3.6 (LLVM ...), X8_D24_UNORM_PACK32": device, driver, depth format.
     [[nodiscard]] std::string renderer() const;
     [[nodiscard]] int width() const { return width_; }
     [[nodiscard]] int height() const { return height_; }

@@ -47,6 +47,7 @@ Tally run_format(raster::DepthFormat format, int width, int height, int scenes, 
     Tally t;
     auto dev = cullide_oracle::VulkanDevice::create(width, height, format);
     REQUIRE_MESSAGE(dev.ok(), (dev.ok() ? "" : dev.error().message));
+    if (width == 64) std::printf("lavapipe: %s\n", dev.value()->renderer().c_str());
     raster_test::SplitMix64 rng(seed);
     raster_test::Scene scene;
     bool reported_query = false, reported_pixel = false;
