@@ -6,11 +6,11 @@
 #
 #   library        TBB (threads; serial executor without it: the embedded configuration)
 #   front door     Eigen (the libigl-style V/F entry points of cullide/eigen.h, header-only)
-#   tests          GMP (rational references), OSMesa and Embree (oracles), doctest (the runner, needed
-#                  by CULLIDE_BUILD_TESTS)
+#   tests          GMP (rational references), OSMesa, Vulkan (lavapipe) and Embree (oracles), doctest
+#                  (the runner, needed by CULLIDE_BUILD_TESTS)
 #   benchmarks     Google Benchmark (needed by CULLIDE_BUILD_BENCHMARKS), and the peers FCL, Bullet,
 #                  CGAL (peers_bench, spatialhash_bench)
-# None of OSMesa, Embree, GMP, FCL, Bullet and CGAL is ever linked into a library.
+# None of OSMesa, Vulkan, Embree, GMP, FCL, Bullet and CGAL is ever linked into a library.
 
 option(CULLIDE_STRICT_DEPS "Fail when a package switched on by CULLIDE_WITH_* is not found" OFF)
 option(CULLIDE_WITH_GMP "Use GMP for the rational references of tests and fuzzers" ON)
@@ -58,6 +58,19 @@ if(CULLIDE_WITH_OSMESA)
   endif()
 endif()
 _cullide_dep(OSMesa "${CULLIDE_WITH_OSMESA}" "${OSMesa_FOUND}" "the real-GL conformance checks are skipped")
+
+# Vulkan: the loader and headers (libvulkan-dev) plus glslangValidator (glslang-tools) to build the
+# oracle's vertex shader to SPIR-V; the device it looks for at run time is Mesa's lavapipe.
+if(CULLIDE_WITH_VULKAN)
+  find_package(Vulkan QUIET)
+  find_program(CULLIDE_GLSLANG_VALIDATOR glslangValidator)
+endif()
+set(_cullide_vulkan_found OFF)
+if(Vulkan_FOUND AND CULLIDE_GLSLANG_VALIDATOR)
+  set(_cullide_vulkan_found ON)
+endif()
+_cullide_dep(Vulkan "${CULLIDE_WITH_VULKAN}" "${_cullide_vulkan_found}"
+             "the Vulkan-rules (lavapipe) conformance checks are skipped")
 
 if(CULLIDE_WITH_EMBREE)
   find_package(embree 3 QUIET)

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The whole test suite: installs what is missing, builds everything (RelWithDebInfo, warnings as
-# errors, TBB + the OSMesa and Embree oracles, every dependency switch explicit) and runs every test but the `slow` ones.
+# errors, TBB + the OSMesa, Vulkan and Embree oracles, every dependency switch explicit) and runs every test but the `slow` ones.
 # usage: scripts/test.sh [extra ctest arguments...]
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -13,7 +13,7 @@ if [ ! -f "$build/CMakeCache.txt" ]; then
   # they happen to be here (.ci/run builds them hidden as well: the peers-hidden step).
   cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCULLIDE_WERROR=ON \
     -DCULLIDE_STRICT_DEPS=ON -DCULLIDE_WITH_TBB=ON -DCULLIDE_WITH_EIGEN=ON -DCULLIDE_WITH_GMP=ON \
-    -DCULLIDE_WITH_OSMESA=ON -DCULLIDE_WITH_EMBREE=ON -DCULLIDE_BUILD_TESTS=ON -DCULLIDE_BUILD_BENCHMARKS=ON \
+    -DCULLIDE_WITH_OSMESA=ON -DCULLIDE_WITH_VULKAN=ON -DCULLIDE_WITH_EMBREE=ON -DCULLIDE_BUILD_TESTS=ON -DCULLIDE_BUILD_BENCHMARKS=ON \
     -DCULLIDE_WITH_FCL=OFF -DCULLIDE_WITH_BULLET=OFF -DCULLIDE_WITH_CGAL=OFF >/dev/null
 fi
 cmake --build "$build" -j"$(nproc)"

@@ -378,7 +378,10 @@ void print_table_header(std::ostream& out, const BenchArgs& a, double load_start
     out << "cullide " << (a.sweep ? "sweep" : "bench") << ": " << a.frames << " frame(s) from "
         << a.first_frame << " step " << a.frame_step << ", warm-up " << a.warmup << ", " << a.reps
         << " rep(s); load " << std::fixed << std::setprecision(2) << load_start << std::defaultfloat << " on "
-        << std::thread::hardware_concurrency() << " hardware threads\n";
+        << std::thread::hardware_concurrency() << " hardware threads";
+    // Said only when not the default, so the usual header stays as it was.
+    if (a.base.gpu_rules != raster::RasterRules::GlLlvmpipe) out << "; gpu rules " << to_string(a.base.gpu_rules);
+    out << "\n";
     out << std::left << std::setw(13) << "scene" << std::setw(6) << "scale" << std::setw(16) << "method"
         << std::setw(6) << "res" << std::setw(5) << "dep" << std::setw(4) << "thr" << std::right
         << std::setw(10) << "ms/frame" << std::setw(10) << "median" << std::setw(22) << "[min, max]"

@@ -137,6 +137,8 @@ int run_command(const std::vector<std::string>& args, std::ostream& out, std::os
         if (visibility) {
             out << ", resolution " << r.options.resolution << ", depth " << to_string(r.options.depth_format)
                 << ", sub-object " << r.options.subobject_triangles << " triangles";
+            if (r.options.gpu_rules != raster::RasterRules::GlLlvmpipe)
+                out << ", gpu rules " << to_string(r.options.gpu_rules);
         }
         if (r.options.broadphase != BroadPhase::None) out << ", broad phase " << to_string(r.options.broadphase);
         out << ", " << frames << " frame" << (frames == 1 ? "" : "s") << "\n";

@@ -163,6 +163,18 @@ void add_shared_options(std::vector<OptionSpec>& t) {
          "",
          "",
          [](const OptionSpec&, const std::string&, Settings& s) { s.pipeline.self = true; }});
+    t.push_back({"--gpu-rules",
+                 "R",
+                 kAllCommands,
+                 "rasterization rules of the GL-exact views (cullide, qcullide-gl): gl (OpenGL on llvmpipe) or "
+                 "vulkan (Vulkan as lavapipe: top-left rule on y-down, depth in [0, 1], first provoking vertex); "
+                 "rcullide-offset needs gl",
+                 {},
+                 to_string(d.gpu_rules),
+                 "",
+                 [](const OptionSpec& o, const std::string& v, Settings& s) {
+                     s.pipeline.gpu_rules = checked(o, parse_gpu_rules(v));
+                 }});
     t.push_back({"--seed",
                  "S",
                  kAllCommands,

@@ -117,7 +117,8 @@ using detail::make_view;
 using detail::unite;
 
 // This view's geometry of one object (see ObjectGeometry).
-Status prepare_geometry(ObjectGeometry& og, CullStage stage, const raster::OrthoView& view, VisibilityMode mode) {
+Status prepare_geometry(ObjectGeometry& og, CullStage stage, const raster::OrthoView& view, VisibilityMode mode,
+                        raster::RasterRules rules) {
     if (mode == VisibilityMode::Offset) {
         raster::Result<raster::OffsetMesh> m =
             stage == CullStage::Objects ? raster::object_offset_obbs(view, og.positions, og.indices)
@@ -139,7 +140,7 @@ Status prepare_geometry(ObjectGeometry& og, CullStage stage, const raster::Ortho
     og.clip.resize(c.value().size());
     for (std::size_t i = 0; i < og.clip.size(); ++i) {
         const raster::Double4& d = c.value()[i];
-        og.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), static_cast<float>(d.z), 1.0f};
+        og.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), detail::gl_exact_clip_depth(d.z, rules), 1.0f};
     }
     return Status{};
 }
@@ -267,7 +268,7 @@ Result<std::uint64_t> recorded_view(std::vector<ObjectGeometry>& g, std::vector<
     std::array<raster::QueryResults, 2> results;
     for (int pass = 0; pass < 2; ++pass) {
         if (pass == 1) std::reverse(order.begin(), order.end());  // pass 2 runs backward
-        raster::CommandBatch batch(size.width(), size.height());
+        raster::CommandBatch batch(size.width(), size.height(), o.gpu_rules);
         record_pass(batch, g, order, pass, o.mode, vs);
         if (Status s = device.clear(size.width(), size.height(), o.depth_format); !s) return s.error();
         Result<raster::QueryResults> r = device.execute(batch);
@@ -300,7 +301,7 @@ Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_
         Result<raster::OrthoView> view = make_view(axis, bounds, extra_depth, size, o.depth_format);
         if (!view) return view.error();
         for (std::size_t i : order)
-            if (Status s = prepare_geometry(g[i], stage, view.value(), o.mode); !s) return s;
+            if (Status s = prepare_geometry(g[i], stage, view.value(), o.mode, o.gpu_rules); !s) return s;
         if (o.mode != VisibilityMode::Offset) return Status{};
         double overshoot = 0.0;  // in clip units beyond [-1, 1]
         for (std::size_t i : order)
@@ -512,6 +513,10 @@ Result<ViewSize> check_visibility_inputs(std::span<const Mesh> objects, std::spa
     if (o.max_rounds < 1 || o.max_rounds > kMaxRounds)
         return Error{"max_rounds must be in 1.." + std::to_string(kMaxRounds) + " (got " + std::to_string(o.max_rounds) + ")"};
     if (o.threads < 0) return Error{"threads must be >= 0 (got " + std::to_string(o.threads) + ")"};
+    if (o.gpu_rules != raster::RasterRules::GlLlvmpipe && o.gpu_rules != raster::RasterRules::Vulkan)
+        return Error{"gpu rules: unknown value " + std::to_string(static_cast<int>(o.gpu_rules))};
+    if (mode == VisibilityMode::Offset && o.gpu_rules != raster::RasterRules::GlLlvmpipe)
+        return Error{"the offset mode (R-CULLIDE's offset solids) is built for the GL rules only; use --gpu-rules gl"};
     if (Status s = validate_scene(objects); !s) return s.error();
     if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
     for (std::size_t k = 0; k < active.size(); ++k) {

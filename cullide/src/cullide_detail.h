@@ -21,6 +21,12 @@ void widen(double& lo, double& hi);
 [[nodiscard]] Result<raster::OrthoView> make_view(int axis, const Aabb& bounds, double extra_depth, ViewSize size,
                                                   raster::DepthFormat format);
 
+// A GL-exact view's clip-space depth as the batch's rules want it, rounded to float once: GL's z
+// in [-1, 1] as it is, Vulkan's (z + 1) / 2 in [0, 1] (the same window depth).
+[[nodiscard]] inline float gl_exact_clip_depth(double clip_z, raster::RasterRules rules) {
+    return static_cast<float>(rules == raster::RasterRules::Vulkan ? (clip_z + 1.0) * 0.5 : clip_z);
+}
+
 // The checks every visibility method makes before drawing anything: option ranges, a valid scene,
 // `active` strictly increasing and in range, and every active object's coordinates inside the
 // exact range (with the ground truth's message, so all methods refuse alike). Returns the views'

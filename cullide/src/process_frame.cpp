@@ -53,6 +53,8 @@ constexpr std::pair<const char*, BroadPhase> kBroadPhases[] = {{"none", BroadPha
                                                                {"brute", BroadPhase::BruteForce}};
 constexpr std::pair<const char*, raster::DepthFormat> kDepthFormats[] = {
     {"d16", raster::DepthFormat::D16}, {"d24", raster::DepthFormat::D24}, {"d32f", raster::DepthFormat::D32F}};
+constexpr std::pair<const char*, raster::RasterRules> kGpuRules[] = {{"gl", raster::RasterRules::GlLlvmpipe},
+                                                                     {"vulkan", raster::RasterRules::Vulkan}};
 
 template <class E, std::size_t N>
 const char* name_of(E e, const std::pair<const char*, E> (&table)[N]) {
@@ -228,6 +230,7 @@ AutoPlan plan_auto(std::span<const Mesh> objects, std::span<const std::uint32_t>
 const char* to_string(Method m) { return name_of(m, kMethods); }
 const char* to_string(BroadPhase b) { return name_of(b, kBroadPhases); }
 const char* to_string(raster::DepthFormat f) { return name_of(f, kDepthFormats); }
+const char* to_string(raster::RasterRules r) { return name_of(r, kGpuRules); }
 
 std::vector<std::string> method_names() {
     std::vector<std::string> names;
@@ -240,6 +243,7 @@ Result<BroadPhase> parse_broadphase(std::string_view name) { return parse_name("
 Result<raster::DepthFormat> parse_depth_format(std::string_view name) {
     return parse_name("depth format", name, kDepthFormats);
 }
+Result<raster::RasterRules> parse_gpu_rules(std::string_view name) { return parse_name("gpu rules", name, kGpuRules); }
 
 int default_resolution(Method m) {
     switch (m) {

@@ -94,7 +94,7 @@ Status run_device(QueryDevice& device, const raster::CommandBatch& batch, ViewSi
 
 // This view's clip coordinates of every geometry with a live item.
 Status transform_geoms(std::vector<Geom>& geoms, const std::vector<char>& geom_live, const raster::OrthoView& view,
-                       VisibilityMode mode) {
+                       VisibilityMode mode, raster::RasterRules rules) {
     for (std::size_t gi = 0; gi < geoms.size(); ++gi) {
         if (!geom_live[gi]) continue;
         Geom& g = geoms[gi];
@@ -107,7 +107,7 @@ Status transform_geoms(std::vector<Geom>& geoms, const std::vector<char>& geom_l
         g.clip.resize(c.value().size());
         for (std::size_t i = 0; i < g.clip.size(); ++i) {
             const raster::Double4& d = c.value()[i];
-            g.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), static_cast<float>(d.z), 1.0f};
+            g.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), detail::gl_exact_clip_depth(d.z, rules), 1.0f};
         }
     }
     return Status{};
@@ -122,7 +122,7 @@ Result<std::uint64_t> run_pass(const std::vector<Geom>& geoms, std::vector<Item>
     const std::uint8_t proven = forward ? kFFV : kSFV;  // what this pass proves
     const std::uint8_t other = forward ? kSFV : kFFV;   // items with this tag are not drawn
     const std::size_t n = items.size();
-    raster::CommandBatch batch(size.width(), size.height());
+    raster::CommandBatch batch(size.width(), size.height(), o.gpu_rules);
     std::size_t cursor = 0;  // draws scheduled so far, counted from the pass's start
     for (std::size_t step = 0; step < n; ++step) {
         const std::size_t k = forward ? step : n - 1 - step;
@@ -180,7 +180,7 @@ Status run_stage(std::vector<Geom>& geoms, std::vector<Item>& items, CullStage s
         const int axis = (first_axis + view) % 3;
         Result<raster::OrthoView> v = detail::make_view(axis, bounds, 0.0, size, o.depth_format);
         if (!v) return v.error();
-        if (Status s = transform_geoms(geoms, geom_live, v.value(), o.mode); !s) return s;
+        if (Status s = transform_geoms(geoms, geom_live, v.value(), o.mode, o.gpu_rules); !s) return s;
         ViewStats vs;
         vs.stage = stage;
         vs.axis = axis;

@@ -21,8 +21,9 @@ namespace {
 constexpr std::uint32_t kNoQuery = std::numeric_limits<std::uint32_t>::max();
 constexpr int kTileSize = 64;  // llvmpipe's tile size; one task owns one tile
 
-detail::FrontEndParams params_for(const DepthTarget& target, const DrawState& s) {
+detail::FrontEndParams params_for(const DepthTarget& target, RasterRules rules, const DrawState& s) {
     detail::FrontEndParams p{};
+    p.rules = rules;
     p.target_width = target.width();
     p.target_height = target.height();
     p.viewport = s.viewport ? *s.viewport : Viewport{0, 0, target.width(), target.height()};
@@ -79,7 +80,7 @@ Result<QueryResults> execute_reference(DepthTarget& target, const CommandBatch& 
             active = kNoQuery;
             continue;
         }
-        const detail::FrontEndParams p = params_for(target, c.state);
+        const detail::FrontEndParams p = params_for(target, batch.rules(), c.state);
         const detail::DepthState depth_state{target.format(), c.state.depth_func, c.state.depth_write};
         if (c.state.mode == RasterMode::ExactBounds) {
             btris.clear();
@@ -175,7 +176,7 @@ SetupDraws front_end(const DepthTarget& target, const CommandBatch& batch, const
     detail::parallel_for(threads, pieces.size(), [&](std::size_t j) {
         const std::size_t d = pieces[j].draw;
         const Command& c = cmds[draws.cmds[d]];
-        const detail::FrontEndParams p = params_for(target, c.state);
+        const detail::FrontEndParams p = params_for(target, batch.rules(), c.state);
         if (c.state.mode == RasterMode::ExactBounds) {
             setup_bounds_draw(p, c, draws.cmds[d], out.bounds[d], out.pool[d]);
             return;

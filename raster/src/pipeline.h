@@ -44,12 +44,23 @@ struct FrontEndParams {
     Viewport viewport;
     CullFace cull_face;
     FrontFace front_face;
+    RasterRules rules = RasterRules::GlLlvmpipe;  // GL-exact setup only (exact bounds ignore it)
 };
 
 // Runs clipping and setup for one input triangle (clip-space vertices a, b, c), appending 0..n
-// SetupTri (a clipped triangle becomes a fan). Inputs were validated (finite).
-void setup_triangle(const FrontEndParams& params, const Float4& a, const Float4& b, const Float4& c,
-                    std::uint32_t draw, std::vector<SetupTri>& out);
+// SetupTri (a clipped triangle becomes a fan). Inputs were validated (finite). One instantiation per
+// rule set (src/triangle_setup.cpp), so each is compiled with its rules as constants; the choice is
+// inline here, where a caller's loop over a draw's triangles can hoist it.
+template <RasterRules Rules>
+void setup_triangle_for(const FrontEndParams& params, const Float4& a, const Float4& b, const Float4& c,
+                        std::uint32_t draw, std::vector<SetupTri>& out);
+inline void setup_triangle(const FrontEndParams& params, const Float4& a, const Float4& b, const Float4& c,
+                           std::uint32_t draw, std::vector<SetupTri>& out) {
+    if (params.rules == RasterRules::Vulkan)
+        setup_triangle_for<RasterRules::Vulkan>(params, a, b, c, draw, out);
+    else
+        setup_triangle_for<RasterRules::GlLlvmpipe>(params, a, b, c, draw, out);
+}
 
 // Rasterizes `tri` over `rect` (inside the target and the triangle's box) into `depth` with the
 // draw's depth `state`. Returns the samples that passed.

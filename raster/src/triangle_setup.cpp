@@ -32,18 +32,44 @@ constexpr float kPlanes[6][4] = {
     {0.0f, 0.0f, 1.0f, 1.0f},   // z >= -w (near, GL depth mode)
     {0.0f, 0.0f, -1.0f, 1.0f},  // z <= w (far)
 };
+// The near plane in the [0, 1] depth mode (gallium's clip_halfz, which lavapipe always sets).
+constexpr float kNearPlaneHalfZ[4] = {0.0f, 0.0f, 1.0f, 0.0f};  // z >= 0
+
+// What the front end does differently under each rule set (raster.h). Both sets share everything
+// else: pixel centres at +0.5 (half_pixel_center), 16.8 snapping, no guard band, the depth plane.
+struct RuleSet {
+    bool half_z;              // clip 0 <= z <= w, z_w = z/w (scale 1, bias 0); else -w <= z <= w, z/w * 0.5 + 0.5
+    bool bottom_edge_rule;    // llvmpipe's bottom_edge_rule (the horizontal-edge tie)
+    bool lp_positive_is_ccw;  // llvmpipe's positive area is the API's counter-clockwise
+    bool provoking_first;     // flatshade_first: the provoking vertex is a triangle's first (Vulkan) or last (GL)
+};
+
+// Vulkan as lavapipe sets gallium's rasterizer state: clip_halfz, flatshade_first (Vulkan's
+// provoking vertex is the first), front_ccw straight from VkFrontFace, which reads Vulkan's
+// counter-clockwise (y down) as llvmpipe's positive area, the opposite of GL on a y-up FBO; the same
+// fill convention as GL (no bottom_edge_rule: both APIs' top/bottom edge is at framebuffer y's low
+// end). Pinned against lavapipe by tests/raster/vulkan_conformance_test.cpp.
+constexpr RuleSet rule_set(RasterRules rules) {
+    if (rules == RasterRules::Vulkan) return {true, kBottomEdgeRule, !kLpPositiveIsCcw, true};
+    return {false, kBottomEdgeRule, kLpPositiveIsCcw, false};
+}
 
 // Left to right, as the C compiler evaluates it (no contraction on baseline x86-64).
 float dot4(const float* a, const float* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]; }
 
+const float* clip_plane(const RuleSet& r, int plane) {
+    return plane == 4 && r.half_z ? kNearPlaneHalfZ : kPlanes[plane];
+}
+
 // The clip mask bits, as the vertex shader computes them (same plane order).
+template <bool HalfZ>
 unsigned clip_mask(const float* p) {
     unsigned m = 0;
     if (p[0] > p[3]) m |= 1u;
     if (0.0f > p[0] + p[3]) m |= 2u;
     if (p[1] > p[3]) m |= 4u;
     if (0.0f > p[1] + p[3]) m |= 8u;
-    if (0.0f > p[2] + p[3]) m |= 16u;
+    if (HalfZ ? 0.0f > p[2] : 0.0f > p[2] + p[3]) m |= 16u;
     if (p[2] > p[3]) m |= 32u;
     return m;
 }
@@ -53,16 +79,16 @@ struct ViewportXform {
     float translate[3];
 };
 
-ViewportXform make_xform(const Viewport& vp) {
+ViewportXform make_xform(const RuleSet& r, const Viewport& vp) {
     ViewportXform x{};
     const float hw = static_cast<float>(vp.width) * 0.5f;
     const float hh = static_cast<float>(vp.height) * 0.5f;
     x.scale[0] = hw;
     x.scale[1] = hh;
-    x.scale[2] = 0.5f;
+    x.scale[2] = r.half_z ? 1.0f : 0.5f;  // Vulkan: maxDepth - minDepth; GL: (far - near) / 2
     x.translate[0] = hw + static_cast<float>(vp.x);
     x.translate[1] = hh + static_cast<float>(vp.y);
-    x.translate[2] = 0.5f;
+    x.translate[2] = r.half_z ? 0.0f : 0.5f;  // Vulkan: minDepth; GL: (far + near) / 2
     return x;
 }
 
@@ -90,9 +116,12 @@ ClipVertex interpolate(const ViewportXform& xf, float t, const ClipVertex& out, 
     return d;
 }
 
-// llvmpipe's setup of one (post-clip) triangle in window coordinates.
-void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const ClipVertex* v1,
-                           const ClipVertex* v2, std::uint32_t draw, std::vector<SetupTri>& out) {
+// llvmpipe's setup of one (post-clip) triangle in window coordinates. A template on the rules, so
+// each rule set's front end is compiled with its choices as constants (the GL path is as it was).
+template <RasterRules Rules>
+void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const ClipVertex* v1, const ClipVertex* v2,
+                           std::uint32_t draw, std::vector<SetupTri>& out) {
+    constexpr RuleSet rules = rule_set(Rules);
     // Snap to 16.8 after moving the pixel centre to the integer lattice (round half to even, as
     // cvtps2dq does in the default rounding mode).
     auto snap = [](float w) { return static_cast<int64_t>(std::lrint((w - 0.5f) * kFixedOne)); };
@@ -103,23 +132,25 @@ void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const 
     if (area == 0) return;
 
     const bool lp_positive = area > 0;
-    const bool gl_ccw = kLpPositiveIsCcw ? lp_positive : !lp_positive;
+    const bool gl_ccw = rules.lp_positive_is_ccw ? lp_positive : !lp_positive;
     const bool front = gl_ccw == (p.front_face == FrontFace::CCW);
     if (p.cull_face == CullFace::Back && !front) return;
     if (p.cull_face == CullFace::Front && front) return;
 
     // Setup works on llvmpipe's positive orientation; a negative triangle swaps vertices 0 and 1
-    // (provoking vertex last), which also decides the vertex order of the depth plane below.
+    // (provoking vertex last) or 1 and 2 (provoking vertex first), which also decides the vertex
+    // order of the depth plane below.
     const ClipVertex* v[3] = {v0, v1, v2};
     if (!lp_positive) {
-        std::swap(v[0], v[1]);
-        std::swap(x[0], x[1]);
-        std::swap(y[0], y[1]);
+        const int a = rules.provoking_first ? 1 : 0;
+        std::swap(v[a], v[a + 1]);
+        std::swap(x[a], x[a + 1]);
+        std::swap(y[a], y[a + 1]);
     }
 
     SetupTri t{};
     // Bounding box (inclusive), llvmpipe's rounding for its fill convention.
-    const int adj = kBottomEdgeRule ? 1 : 0;
+    const int adj = rules.bottom_edge_rule ? 1 : 0;
     const int64_t minx = std::min({x[0], x[1], x[2]}), maxx = std::max({x[0], x[1], x[2]});
     const int64_t miny = std::min({y[0], y[1], y[2]}), maxy = std::max({y[0], y[1], y[2]});
     int64_t bx0 = minx >> kFixedOrder;
@@ -143,7 +174,7 @@ void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const 
         int64_t c = dcdx * x[i] - dcdy * y[i];
         // Fill-rule bias: a centre exactly on the edge counts for left edges (dcdx < 0) and, for
         // horizontal edges, on the side the convention picks.
-        const bool horizontal_in = kBottomEdgeRule ? dcdy < 0 : dcdy >= 0;
+        const bool horizontal_in = rules.bottom_edge_rule ? dcdy < 0 : dcdy >= 0;
         if (dcdx < 0 || (dcdx == 0 && horizontal_in)) c += 1;
         t.c[i] = c;
         t.dcdx[i] = dcdx;
@@ -178,16 +209,18 @@ void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const 
 
 }  // namespace
 
-void setup_triangle(const FrontEndParams& params, const Float4& a, const Float4& b, const Float4& c,
-                    std::uint32_t draw, std::vector<SetupTri>& out) {
-    const ViewportXform xf = make_xform(params.viewport);
+template <RasterRules Rules>
+void setup_triangle_for(const FrontEndParams& params, const Float4& a, const Float4& b, const Float4& c,
+                        std::uint32_t draw, std::vector<SetupTri>& out) {
+    constexpr RuleSet rules = rule_set(Rules);
+    const ViewportXform xf = make_xform(rules, params.viewport);
     ClipVertex in[3] = {{{a.x, a.y, a.z, a.w}, {}}, {{b.x, b.y, b.z, b.w}, {}}, {{c.x, c.y, c.z, c.w}, {}}};
     unsigned m[3];
-    for (int i = 0; i < 3; ++i) m[i] = clip_mask(in[i].clip);
+    for (int i = 0; i < 3; ++i) m[i] = clip_mask<rules.half_z>(in[i].clip);
     if ((m[0] & m[1] & m[2]) != 0) return;  // wholly outside one plane
     for (auto& v : in) shader_viewport(xf, v);
     if ((m[0] | m[1] | m[2]) == 0) {
-        setup_window_triangle(params, &in[0], &in[1], &in[2], draw, out);
+        setup_window_triangle<Rules>(params, &in[0], &in[1], &in[2], draw, out);
         return;
     }
 
@@ -206,13 +239,13 @@ void setup_triangle(const FrontEndParams& params, const Float4& a, const Float4&
         const int plane = std::countr_zero(mask);
         mask &= ~(1u << plane);
         const ClipVertex* prev = inlist[0];
-        float dp_prev = dot4(prev->clip, kPlanes[plane]);
+        float dp_prev = dot4(prev->clip, clip_plane(rules, plane));
         if (!std::isfinite(dp_prev)) return;
         inlist[n] = inlist[0];
         int count = 0;
         for (int i = 1; i <= n; ++i) {
             const ClipVertex* cur = inlist[i];
-            const float dp = dot4(cur->clip, kPlanes[plane]);
+            const float dp = dot4(cur->clip, clip_plane(rules, plane));
             if (!std::isfinite(dp)) return;
             bool different;
             if (dp_prev >= 0.0f) {
@@ -246,9 +279,20 @@ void setup_triangle(const FrontEndParams& params, const Float4& a, const Float4&
         std::swap(inlist, outlist);
         n = count;
     }
-    // The polygon as a fan, provoking vertex (the first) last in each triangle.
-    for (int i = 2; i < n; ++i) setup_window_triangle(params, inlist[i - 1], inlist[i], inlist[0], draw, out);
+    // The polygon as a fan, its first vertex (the provoking one) last in each triangle, or first when
+    // the provoking vertex is the first (draw_pipe_clip.c's emit_poly).
+    for (int i = 2; i < n; ++i) {
+        if (rules.provoking_first)
+            setup_window_triangle<Rules>(params, inlist[0], inlist[i - 1], inlist[i], draw, out);
+        else
+            setup_window_triangle<Rules>(params, inlist[i - 1], inlist[i], inlist[0], draw, out);
+    }
 }
+
+template void setup_triangle_for<RasterRules::GlLlvmpipe>(const FrontEndParams&, const Float4&, const Float4&,
+                                                          const Float4&, std::uint32_t, std::vector<SetupTri>&);
+template void setup_triangle_for<RasterRules::Vulkan>(const FrontEndParams&, const Float4&, const Float4&,
+                                                      const Float4&, std::uint32_t, std::vector<SetupTri>&);
 
 }  // namespace raster::detail
 

@@ -183,6 +183,9 @@ TEST_CASE("bad visibility options are usage errors naming the option and the val
     Outcome o = run({"run", "--depth-format", "d8"});
     CHECK(o.status == 2);
     CHECK(has(o.err, "--depth-format: unknown depth format 'd8' (valid: d16, d24, d32f)"));
+    o = run({"run", "--gpu-rules", "metal"});
+    CHECK(o.status == 2);
+    CHECK(has(o.err, "--gpu-rules: unknown gpu rules 'metal' (valid: gl, vulkan)"));
     o = run({"run", "--broadphase", "grid"});
     CHECK(o.status == 2);
     CHECK(has(o.err, "(valid: none, spatialhash, sap, brute)"));

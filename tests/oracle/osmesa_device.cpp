@@ -139,6 +139,8 @@ void OsmesaDevice::clear(double depth) {
 
 raster::Result<raster::QueryResults> OsmesaDevice::run(const raster::CommandBatch& batch) {
     Impl& g = *impl_;
+    if (batch.rules() != raster::RasterRules::GlLlvmpipe)
+        return raster::Error{"osmesa device: the batch is recorded for the Vulkan rules, not GL's"};
     OSMesaMakeCurrent(g.ctx, g.window.data(), GL_UNSIGNED_BYTE, 4, 4);
     glBindFramebuffer(GL_FRAMEBUFFER, g.fbo);
     // One vertex and one index buffer for the whole batch; each draw uses a base vertex. Draws over

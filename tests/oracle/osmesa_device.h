@@ -26,7 +26,7 @@ class OsmesaDevice {
 
     // glClearDepth(depth); glClear(GL_DEPTH_BUFFER_BIT) with the depth mask on.
     void clear(double depth);
-    // Issues every command (all queries first, results read at the end, so GL can batch), then
+    // Fails unless the batch is recorded for RasterRules::GlLlvmpipe. Issues every command (all queries first, results read at the end, so GL can batch), then
     // returns the query results indexed like the batch's queries (0/1 for any-samples queries).
     [[nodiscard]] raster::Result<raster::QueryResults> run(const raster::CommandBatch& batch);
     // The depth buffer, row 0 at the bottom, in raster::DepthTarget's encoding.

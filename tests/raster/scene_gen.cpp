@@ -47,7 +47,7 @@ raster::Float4 random_vertex(SplitMix64& rng, int width, int height, int flavour
 }
 
 void build_scene(Scene& scene, SplitMix64& rng, const SceneOptions& o) {
-    scene.batch = raster::CommandBatch(o.width, o.height);
+    scene.batch = raster::CommandBatch(o.width, o.height, o.rules);
     scene.vertices.clear();
     scene.indices.clear();
     scene.clear_depth = rng.chance(80) ? 1.0 : static_cast<double>(rng.uniform(0.0f, 1.0f));
@@ -90,6 +90,8 @@ void build_scene(Scene& scene, SplitMix64& rng, const SceneOptions& o) {
                     is.insert(is.end(), {a, b, d, a, d, c});
                 }
         }
+        if (o.rules == raster::RasterRules::Vulkan)
+            for (raster::Float4& v : vs) v.z = (v.z + v.w) * 0.5f;
         const raster::MeshView mesh{vs, is};
         raster::DrawState query_state;
         query_state.depth_func = rng.chance(50) ? raster::DepthFunc::GEqual : kFuncs[rng.below(8)];

@@ -45,6 +45,9 @@ struct SceneOptions {
     int objects = 100;        // query + draw pairs (plus some plain draws)
     bool allow_cull = true;
     bool allow_viewport = true;
+    // The batch's rules; Vulkan maps every generated clip z to (z + w) / 2, so the scenes cross
+    // Vulkan's near plane z = 0 as often as GL's z = -w.
+    raster::RasterRules rules = raster::RasterRules::GlLlvmpipe;
 };
 
 // A random vertex: one of several flavours that stress the rules (pixel centres, 1/256 grid,

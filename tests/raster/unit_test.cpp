@@ -311,3 +311,70 @@ TEST_CASE("Orthographic and perspective helpers match the GL formulas and refuse
     REQUIRE_FALSE(e.ok());
     CHECK(e.error().message.find("point 1") != std::string::npos);
 }
+
+TEST_CASE("Vulkan rules: z in [0, w] maps to depth unscaled, z < 0 is clipped, CCW is the other winding") {
+    // Hand-derived from the Vulkan rules at the top of raster/raster.h.
+    const int W = 8, H = 8;
+    const std::vector<std::uint32_t> idx = {0, 1, 2};
+    // A triangle covering the whole target at clip z = 0.25 (w = 1): window depth 0.25 exactly under
+    // Vulkan (fma(0.25, 1, 0)); under GL the same z would be 0.625.
+    const std::vector<Float4> flat = {{-1, -1, 0.25f, 1}, {3, -1, 0.25f, 1}, {-1, 3, 0.25f, 1}};
+    // z = -0.5 everywhere: inside GL's volume (-w <= z), outside Vulkan's (z >= 0).
+    const std::vector<Float4> behind_near = {{-1, -1, -0.5f, 1}, {3, -1, -0.5f, 1}, {-1, 3, -0.5f, 1}};
+    for (const auto rules : {raster::RasterRules::Vulkan, raster::RasterRules::GlLlvmpipe}) {
+        auto t = raster::DepthTarget::create(W, H, DepthFormat::D32F).value();
+        raster::CommandBatch batch(W, H, rules);
+        raster::DrawState s;
+        s.depth_func = DepthFunc::Always;
+        batch.begin_query(raster::QueryKind::SamplesPassed);
+        batch.draw({behind_near, idx}, s);
+        batch.end_query();
+        batch.begin_query(raster::QueryKind::SamplesPassed);
+        batch.draw({flat, idx}, s);
+        batch.end_query();
+        auto r = raster::execute(t, batch);
+        REQUIRE(r.ok());
+        const bool vk = rules == raster::RasterRules::Vulkan;
+        CHECK(r.value() == raster::QueryResults{vk ? 0u : 64u, 64});
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) CHECK(t.depth(x, y) == (vk ? 0.25 : 0.625));
+    }
+    // Crossing Vulkan's near plane at x = 0 (z = 0 there): only the left half (z >= 0) remains.
+    {
+        auto t = raster::DepthTarget::create(W, H, DepthFormat::D32F).value();
+        const std::vector<Float4> crossing = {{-1, -1, 0.5f, 1}, {1, -1, -0.5f, 1}, {1, 1, -0.5f, 1},
+                                              {-1, 1, 0.5f, 1}};
+        const std::vector<std::uint32_t> quad = {0, 1, 2, 0, 2, 3};
+        raster::CommandBatch batch(W, H, raster::RasterRules::Vulkan);
+        raster::DrawState s;
+        s.depth_func = DepthFunc::Always;
+        batch.begin_query(raster::QueryKind::SamplesPassed);
+        batch.draw({crossing, quad}, s);
+        batch.end_query();
+        auto r = raster::execute(t, batch);
+        REQUIRE(r.ok());
+        CHECK(r.value()[0] == 32);  // columns 0..3 of 8, every row
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) CHECK((x < 4) == (t.depth(x, y) < 1.0));
+    }
+    // Facing: GL's counter-clockwise triangle (y up) is clockwise on Vulkan's y-down framebuffer, so
+    // FrontFace::CCW + back-face culling keeps the other one.
+    {
+        const std::vector<Float4> gl_ccw = {{-1, -1, 0, 1}, {3, -1, 0, 1}, {-1, 3, 0, 1}};
+        const std::vector<Float4> gl_cw = {{-1, -1, 0, 1}, {-1, 3, 0, 1}, {3, -1, 0, 1}};
+        auto t = raster::DepthTarget::create(W, H, DepthFormat::D24).value();
+        raster::CommandBatch batch(W, H, raster::RasterRules::Vulkan);
+        for (const auto* m : {&gl_ccw, &gl_cw}) {
+            raster::DrawState s;
+            s.depth_func = DepthFunc::Always;
+            s.depth_write = false;
+            s.cull_face = raster::CullFace::Back;
+            batch.begin_query(raster::QueryKind::SamplesPassed);
+            batch.draw({*m, idx}, s);
+            batch.end_query();
+        }
+        auto r = raster::execute(t, batch);
+        REQUIRE(r.ok());
+        CHECK(r.value() == raster::QueryResults{0, 64});
+    }
+}

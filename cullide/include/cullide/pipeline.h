@@ -73,6 +73,9 @@ enum class BroadPhase { None, SpatialHash, SweepAndPrune, BruteForce };
 [[nodiscard]] const char* to_string(raster::DepthFormat f);
 // "d16", "d24", "d32f"; the error lists the valid names.
 [[nodiscard]] Result<raster::DepthFormat> parse_depth_format(std::string_view name);
+[[nodiscard]] const char* to_string(raster::RasterRules r);
+// "gl" (OpenGL on llvmpipe), "vulkan" (Vulkan as lavapipe); the error lists the valid names.
+[[nodiscard]] Result<raster::RasterRules> parse_gpu_rules(std::string_view name);
 
 [[nodiscard]] const char* to_string(Method m);
 // Parses a method name; the error lists the valid names.

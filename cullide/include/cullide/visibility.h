@@ -80,6 +80,12 @@ struct VisibilityOptions {
     int max_rounds = 4;           // rounds of x, y, z views per stage, 1..kMaxRounds
     int threads = 0;              // workers (exact stage, emulator); 0 = all hardware threads.
                                   // Results do not depend on it.
+    // Whose rasterization rules the GL-exact views follow (raster::RasterRules): OpenGL on llvmpipe
+    // (clip z in [-1, 1]) or Vulkan as lavapipe (clip z in [0, 1]; the batches are recorded that
+    // way, so a Vulkan device runs them as they are). Changes which pixels a view covers, so the
+    // GL-exact mode's misses may differ (docs/raster.md); the reliable modes' answers do not depend
+    // on it (exact bounds is conservative under both) and the offset mode refuses Vulkan.
+    raster::RasterRules gpu_rules = raster::RasterRules::GlLlvmpipe;
 };
 
 enum class CullStage : std::uint8_t { Boxes, Objects, SubObjects };

@@ -27,7 +27,8 @@ struct Command {
 // first and reports the first problem (naming the command, the element and the limit).
 class CommandBatch {
    public:
-    CommandBatch(int target_width, int target_height) : width_(target_width), height_(target_height) {}
+    CommandBatch(int target_width, int target_height, RasterRules rules = RasterRules::GlLlvmpipe)
+        : width_(target_width), height_(target_height), rules_(rules) {}
 
     void draw(MeshView mesh, const DrawState& state);
     // Double-precision input for RasterMode::ExactBounds (docs/reliable-raster.md). execute() fails,
@@ -42,6 +43,8 @@ class CommandBatch {
 
     [[nodiscard]] int target_width() const { return width_; }
     [[nodiscard]] int target_height() const { return height_; }
+    // The API whose rules the batch's GL-exact draws follow (types.h); clear() keeps it.
+    [[nodiscard]] RasterRules rules() const { return rules_; }
     [[nodiscard]] const std::vector<Command>& commands() const { return commands_; }
     [[nodiscard]] const std::vector<QueryKind>& query_kinds() const { return query_kinds_; }
     void clear();
@@ -49,6 +52,7 @@ class CommandBatch {
    private:
     int width_;
     int height_;
+    RasterRules rules_;
     std::vector<Command> commands_;
     std::vector<QueryKind> query_kinds_;
 };

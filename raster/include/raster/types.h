@@ -32,6 +32,13 @@ enum class FrontFace : std::uint8_t { CCW, CW };           // glFrontFace
 //               input only; double input through CommandBatch::draw(MeshViewD, ...).
 enum class RasterMode : std::uint8_t { GLExact, ExactBounds };
 
+// Whose rasterization rules GL-exact draws follow (raster/raster.h lists both sets), chosen per
+// batch (CommandBatch). The batch's clip coordinates must be recorded for the same API (Vulkan:
+// 0 <= z <= w). Exact-bounds draws are conservative and follow GL's conventions under both.
+//  GlLlvmpipe: OpenGL on Mesa llvmpipe (OSMesa 22.3.6), bit-identical; the default.
+//  Vulkan:     Vulkan's rules as Mesa lavapipe 22.3.6 implements them, bit-identical.
+enum class RasterRules : std::uint8_t { GlLlvmpipe, Vulkan };
+
 enum class QueryKind : std::uint8_t { SamplesPassed, AnySamplesPassed };
 
 // glViewport(x, y, width, height) in pixels.
