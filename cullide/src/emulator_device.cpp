@@ -91,7 +91,7 @@ void mark_triangle(const WindowXY (&v)[3], int width, int height, const Mark& ma
     if (row0 > row1) return;
     const int x0 = floor_within(std::min({v[0].x, v[1].x, v[2].x}), -4, width + 4) - 2;
     const int x1 = floor_within(std::max({v[0].x, v[1].x, v[2].x}), -4, width + 4) + 2;
-    for (int y = row0; y <= row1; ++y) mark(y, x0, x1);
+    mark(row0, row1, x0, x1);
 }
 
 // Marks the triangles of one draw; false when a vertex is not an orthographic one (w != 1), which
@@ -117,7 +117,17 @@ void EmulatorDevice::mark_writes(const raster::CommandBatch& batch) {
     if (written_lo_.empty()) return;  // a small target: cleared in full
     const int width = target_->width();
     const int height = target_->height();
-    const auto row_mark = [this](int y, int x0, int x1) { mark(y, x0, x1); };
+    // Rows y0..y1 (within the target) widen their spans to [x0, x1] clamped to the target: the
+    // clamp once per box, the rows a tight loop (it was out of line per row: 3-8% of a frame).
+    const auto row_mark = [this, width](int y0, int y1, int x0, int x1) {
+        const int lo = std::max(x0, 0), hi = std::min(x1, width - 1);
+        int* const wl = written_lo_.data();
+        int* const wh = written_hi_.data();
+        for (int y = y0; y <= y1; ++y) {
+            wl[y] = std::min(wl[y], lo);
+            wh[y] = std::max(wh[y], hi);
+        }
+    };
     for (const raster::Command& c : batch.commands()) {
         if (c.kind != raster::Command::Kind::Draw || !c.state.depth_write) continue;
         // A viewport other than the whole target: its transform is not the one above.
