@@ -120,9 +120,9 @@ struct Draws {
     std::vector<std::uint32_t> cmd_query;  // per command: the active query, or kNoQuery
 };
 
-Draws draws(const CommandBatch& batch) {
+void draws(const CommandBatch& batch, Draws& d) {
     const auto& cmds = batch.commands();
-    Draws d;
+    d.cmds.clear();
     d.cmd_query.assign(cmds.size(), kNoQuery);
     std::uint32_t active = kNoQuery;
     for (std::size_t i = 0; i < cmds.size(); ++i) {
@@ -135,7 +135,6 @@ Draws draws(const CommandBatch& batch) {
             d.cmd_query[i] = active;
         }
     }
-    return d;
 }
 
 // The front end's output, one list per draw (a GL-exact draw fills `tris`, an exact-bounds draw
@@ -150,12 +149,20 @@ struct SetupDraws {
 // command order whatever the schedule. With several threads, a big GL-exact draw is split into
 // pieces of kFrontEndPiece triangles; piece 0 fills the draw's list, the others their own lists,
 // appended after in piece order (so the list is the same as one serial pass, whatever the count).
-SetupDraws front_end(const DepthTarget& target, const CommandBatch& batch, const Draws& draws, int threads) {
+// Resizes a list of lists to n and empties the first n (capacity kept: see Scratch).
+template <class T>
+void reset_lists(std::vector<std::vector<T>>& lists, std::size_t n) {
+    if (lists.size() < n) lists.resize(n);
+    for (std::size_t i = 0; i < n; ++i) lists[i].clear();
+}
+
+void front_end(const DepthTarget& target, const CommandBatch& batch, const Draws& draws, int threads,
+               SetupDraws& out, std::vector<std::vector<detail::SetupTri>>& piece_out) {
     const auto& cmds = batch.commands();
     const std::size_t n_draws = draws.cmds.size();
-    SetupDraws out{std::vector<std::vector<detail::SetupTri>>(n_draws),
-                   std::vector<std::vector<detail::BoundsTri>>(n_draws),
-                   std::vector<std::vector<detail::BoundsVertex>>(n_draws)};
+    reset_lists(out.tris, n_draws);
+    reset_lists(out.bounds, n_draws);
+    reset_lists(out.pool, n_draws);
     constexpr std::size_t kFrontEndPiece = 2048;
     struct Piece {
         std::uint32_t draw;
@@ -172,7 +179,7 @@ SetupDraws front_end(const DepthTarget& target, const CommandBatch& batch, const
         for (std::size_t k = 0; k < n; k += 3 * kFrontEndPiece)
             pieces.push_back({static_cast<std::uint32_t>(d), k, std::min(n, k + 3 * kFrontEndPiece)});
     }
-    std::vector<std::vector<detail::SetupTri>> piece_out(pieces.size());
+    reset_lists(piece_out, pieces.size());
     detail::parallel_for(threads, pieces.size(), [&](std::size_t j) {
         const std::size_t d = pieces[j].draw;
         const Command& c = cmds[draws.cmds[d]];
@@ -191,7 +198,6 @@ SetupDraws front_end(const DepthTarget& target, const CommandBatch& batch, const
     for (std::size_t j = 0; j < pieces.size(); ++j)
         if (pieces[j].k0 != 0)
             out.tris[pieces[j].draw].insert(out.tris[pieces[j].draw].end(), piece_out[j].begin(), piece_out[j].end());
-    return out;
 }
 
 // The target cut into kTileSize squares, row-major.
@@ -211,8 +217,9 @@ struct Ref {
 // Binning: each tile lists the triangles overlapping it, in command order. In parallel over bands
 // of tile rows: each band walks every triangle in command order and fills only its own tiles, so
 // every bin is the same list for any thread count.
-std::vector<std::vector<Ref>> bin(const SetupDraws& setup, const Tiles& tiles, int threads) {
-    std::vector<std::vector<Ref>> bins(tiles.count());
+void bin(const SetupDraws& setup, std::size_t n_draws, const Tiles& tiles, int threads,
+         std::vector<std::vector<Ref>>& bins) {
+    reset_lists(bins, tiles.count());
     const int bands = threads > 1 ? std::min(threads, tiles.y) : 1;
     detail::parallel_for(threads, static_cast<std::size_t>(bands), [&](std::size_t band) {
         const auto n_bands = static_cast<std::size_t>(bands);
@@ -225,7 +232,7 @@ std::vector<std::vector<Ref>> bin(const SetupDraws& setup, const Tiles& tiles, i
             for (int ty = std::max(by0 / kTileSize, band_ty0); ty <= std::min(by1 / kTileSize, band_ty1); ++ty)
                 for (int tx = bx0 / kTileSize; tx <= bx1 / kTileSize; ++tx) add(d, t, tx, ty);
         };
-        for (std::size_t d = 0; d < setup.tris.size(); ++d) {
+        for (std::size_t d = 0; d < n_draws; ++d) {
             for (std::size_t t = 0; t < setup.tris[d].size(); ++t) {
                 const auto& tri = setup.tris[d][t];
                 const int ty0 = std::max(tri.y0 / kTileSize, band_ty0), ty1 = std::min(tri.y1 / kTileSize, band_ty1);
@@ -251,7 +258,6 @@ std::vector<std::vector<Ref>> bin(const SetupDraws& setup, const Tiles& tiles, i
             }
         }
     });
-    return bins;
 }
 
 // What every tile's back end reads (shared, read-only but for the depth values of its own tile
@@ -314,20 +320,37 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
                      " is out of range: it must be >= 0 (0 = all hardware threads)"};
     if (Status s = detail::validate(target, batch); !s) return s.error();
     const int threads = detail::effective_threads(options.threads);
-    const Draws draw_list = draws(batch);
-    const SetupDraws setup = front_end(target, batch, draw_list, threads);
+    // Buffers kept from one batch to the next on this thread (capacity only: every list is
+    // emptied before use, so no result depends on an earlier batch). CULLIDE issues thousands of
+    // small batches per frame; allocating these afresh each time returned memory to the kernel and
+    // faulted it back in, serial work that made 2 threads slower than 1 (perf, issue #17).
+    struct Scratch {
+        Draws draw_list;
+        SetupDraws setup;
+        std::vector<std::vector<detail::SetupTri>> piece_out;
+        std::vector<std::vector<Ref>> bins;
+        std::vector<std::vector<std::pair<std::uint32_t, std::uint64_t>>> tile_counts;
+        std::vector<std::atomic<bool>> answered;
+    };
+    thread_local Scratch scratch;
+    Draws& draw_list = scratch.draw_list;
+    draws(batch, draw_list);
+    front_end(target, batch, draw_list, threads, scratch.setup, scratch.piece_out);
+    const SetupDraws& setup = scratch.setup;
     const Tiles tiles{(target.width() + kTileSize - 1) / kTileSize, (target.height() + kTileSize - 1) / kTileSize};
-    const std::vector<std::vector<Ref>> bins = bin(setup, tiles, threads);
+    bin(setup, draw_list.cmds.size(), tiles, threads, scratch.bins);
+    const std::vector<std::vector<Ref>>& bins = scratch.bins;
 
     // Back end: one task per tile.
     const std::size_t n_queries = batch.query_kinds().size();
-    const std::unique_ptr<std::atomic<bool>[]> answered(new std::atomic<bool>[n_queries + 1]);
-    for (std::size_t q = 0; q <= n_queries; ++q) answered[q].store(false, std::memory_order_relaxed);
+    if (scratch.answered.size() < n_queries + 1) scratch.answered = std::vector<std::atomic<bool>>(n_queries + 1);
+    for (std::size_t q = 0; q <= n_queries; ++q) scratch.answered[q].store(false, std::memory_order_relaxed);
     const ShadeContext ctx{batch,          draw_list,       setup,
                            {target.mutable_values().data(), target.width()},
                            target.width(), target.height(), target.format(),
-                           options.allow_simd, answered.get()};
-    std::vector<std::vector<std::pair<std::uint32_t, std::uint64_t>>> tile_counts(tiles.count());
+                           options.allow_simd, scratch.answered.data()};
+    auto& tile_counts = scratch.tile_counts;
+    reset_lists(tile_counts, tiles.count());
     detail::parallel_for(threads, tiles.count(), [&](std::size_t tile) {
         const int tx = static_cast<int>(tile % static_cast<std::size_t>(tiles.x));
         const int ty = static_cast<int>(tile / static_cast<std::size_t>(tiles.x));
@@ -335,8 +358,8 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
     });
 
     QueryResults results(n_queries, 0);
-    for (const auto& counts : tile_counts)
-        for (const auto& [q, n] : counts) results[q] += n;
+    for (std::size_t tile = 0; tile < tiles.count(); ++tile)
+        for (const auto& [q, n] : tile_counts[tile]) results[q] += n;
     finish_results(batch, results);
     return results;
 }

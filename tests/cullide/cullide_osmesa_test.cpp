@@ -84,3 +84,35 @@ TEST_CASE("the OSMesa device refuses the exact-bounds mode, which real GL does n
     REQUIRE_FALSE(r.ok());
     CHECK(r.error().message.find("exact-bounds mode") != std::string::npos);
 }
+
+// Issue #17: whole CULLIDE frames at the methods' own 1024^2, where one batch holds thousands of
+// queries. The OSMesa device gets every batch whole (its bounded scenes keep llvmpipe off the
+// path that over-counts: tests/oracle/llvmpipe_scene_test.cpp); every view's PCS, the queries
+// and the pairs must equal the emulator's.
+TEST_CASE("whole CULLIDE frames at 1024^2: OSMesa and the emulator agree pass for pass") {
+    auto device = cullide_oracle::make_osmesa_query_device();
+    REQUIRE(device.ok());
+    cullide::SceneOptions so;
+    so.scale = 1.0;
+    so.mesh_dir = "";
+    auto scene = cullide::make_scene("cylinders", so);
+    REQUIRE(scene.ok());
+    const cullide::Frame objects = scene.value()->frame(0);
+    std::uint64_t queries = 0;
+    for (cullide::Method m : {cullide::Method::Cullide, cullide::Method::QCullideGL, cullide::Method::RCullideOffset}) {
+        CAPTURE(cullide::to_string(m));
+        cullide::RunOptions o;
+        o.method = m;
+        o.resolution = 1024;
+        o.threads = 2;
+        auto emu = cullide::process_frame(objects, o);
+        REQUIRE(emu.ok());
+        o.device = device.value().get();
+        auto gl = cullide::process_frame(objects, o);
+        REQUIRE(gl.ok());
+        check_same(gl.value(), emu.value());
+        queries += emu.value().stats.queries;
+    }
+    MESSAGE("queries compared: " << queries);
+    CHECK(queries > 20000);  // batches of thousands of queries, as in pipeline_bench
+}

@@ -175,9 +175,23 @@ raster::Result<raster::QueryResults> OsmesaDevice::run(const raster::CommandBatc
     if (!ids.empty()) glGenQueries(static_cast<GLsizei>(ids.size()), ids.data());
     GLenum active_target = 0;
     std::size_t draw = 0;
+    int queries_since_flush = 0;
+    std::size_t triangles_since_flush = 0;
+    // See bounded_scenes in the header: a flush before a query begins, whenever the scene llvmpipe
+    // is filling may be large, so that binning a query's begin and end never meets a full scene.
+    // Only between queries: a flush inside a query would take the path under suspicion.
+    auto bound_scene = [&] {
+        if (!bounded_scenes_) return;
+        if (queries_since_flush < kQueriesPerFlush && triangles_since_flush < kTrianglesPerFlush) return;
+        glFlush();
+        queries_since_flush = 0;
+        triangles_since_flush = 0;
+    };
     for (const auto& c : batch.commands()) {
         switch (c.kind) {
             case raster::Command::Kind::BeginQuery:
+                bound_scene();
+                ++queries_since_flush;
                 active_target = kinds[c.query] == raster::QueryKind::SamplesPassed ? GL_SAMPLES_PASSED
                                                                                  : GL_ANY_SAMPLES_PASSED;
                 glBeginQuery(active_target, ids[c.query]);
@@ -199,6 +213,7 @@ raster::Result<raster::QueryResults> OsmesaDevice::run(const raster::CommandBatc
                 const raster::Viewport vp = s.viewport ? *s.viewport : raster::Viewport{0, 0, width_, height_};
                 glViewport(vp.x, vp.y, vp.width, vp.height);
                 const Range& r = ranges[draw++];
+                triangles_since_flush += r.count / 3;
                 if (r.count > 0)
                     glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(r.count), GL_UNSIGNED_INT,
                                              reinterpret_cast<const void*>(r.first_index * 4),

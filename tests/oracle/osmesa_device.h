@@ -28,7 +28,18 @@ class OsmesaDevice {
     void clear(double depth);
     // Fails unless the batch is recorded for RasterRules::GlLlvmpipe. Issues every command (all queries first, results read at the end, so GL can batch), then
     // returns the query results indexed like the batch's queries (0/1 for any-samples queries).
+    // With bounded scenes (the default) a glFlush goes before a glBeginQuery once
+    // kQueriesPerFlush queries or kTrianglesPerFlush triangles were issued since the last one:
+    // llvmpipe (Mesa 22.3) over-counts a query now and then in one long stream of queries, most
+    // likely when its binned scene fills up while a query's begin/end is binned
+    // (docs/raster-known-differences.md, "Whole batches"); tests/oracle/llvmpipe_scene_test.cpp
+    // shows it with bounded scenes off. glFlush changes no result under the GL rules, so this only
+    // keeps llvmpipe off its faulty path.
     [[nodiscard]] raster::Result<raster::QueryResults> run(const raster::CommandBatch& batch);
+    static constexpr int kQueriesPerFlush = 64;
+    static constexpr std::size_t kTrianglesPerFlush = 16384;
+    void set_bounded_scenes(bool on) { bounded_scenes_ = on; }
+    [[nodiscard]] bool bounded_scenes() const { return bounded_scenes_; }
     // The depth buffer, row 0 at the bottom, in raster::DepthTarget's encoding.
     [[nodiscard]] std::vector<std::uint32_t> read_depth();
     // Waits for the GL work issued so far (for timing).
@@ -45,6 +56,7 @@ class OsmesaDevice {
     int width_ = 0;
     int height_ = 0;
     raster::DepthFormat format_ = raster::DepthFormat::D24;
+    bool bounded_scenes_ = true;
 };
 
 }  // namespace cullide_oracle
