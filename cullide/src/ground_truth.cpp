@@ -1,12 +1,14 @@
 #include "cullide/ground_truth.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <numeric>
 
 #include "cullide/predicates.h"
 #include "exact_stage.h"
+#include "parallel.h"
 
 namespace cullide {
 
@@ -72,32 +74,109 @@ Status validate_exact_range(std::span<const Mesh> objects) {
     return {};
 }
 
+namespace {
+
+// One job of exact_pairs' first pass: triangles [first, last) of an object (indices in range, and
+// their boxes) or its positions [first, last) (coordinates in the exact range).
+struct ScanJob {
+    std::uint32_t object = 0;
+    bool positions = false;
+    std::size_t first = 0, last = 0;
+};
+constexpr std::size_t kScanChunk = 16384;
+
+}  // namespace
+
 Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, const ExactOptions& options,
                                               ExactStats* stats) {
-    if (Status s = validate_scene(objects); !s) return s.error();
-    if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
-    if (Status s = validate_exact_range(objects); !s) return s.error();
-
-    // Every triangle is a candidate set of its own (so the exact stage needs no separate list of
-    // triangle boxes): it sweeps them per pair of objects whose boxes overlap (and per object with
-    // self-collision).
+    // One parallel pass checks the scene (indices, coordinates in the exact range) and computes every
+    // triangle's box and every object's box (mesh_bounds: the union of its triangles' boxes). When it
+    // finds a problem, the serial checks name the first one, with the messages they always give.
     const std::size_t n = objects.size();
-    std::vector<std::vector<std::uint32_t>> welded(options.self ? n : 0);
+    bool ok = std::all_of(objects.begin(), objects.end(), [](const Mesh& m) { return !m.triangles.empty(); }) &&
+              n <= UINT32_MAX;
+    std::vector<std::vector<Aabb>> boxes(n);
+    std::vector<std::vector<detail::FloatBox>> float_boxes(n);
     std::vector<detail::ExactObject> exact(n);
-    std::vector<detail::CandidateSet> sets;
-    ExactStats st;
-    for (const Mesh& m : objects) st.triangles += m.triangles.size();
-    sets.reserve(st.triangles);
-    for (std::size_t i = 0; i < n; ++i) {
-        const Mesh& m = objects[i];
-        const auto object = static_cast<std::uint32_t>(i);
-        for (std::size_t t = 0; t < m.triangles.size(); ++t)
-            sets.push_back({object, static_cast<std::uint32_t>(t), 1, triangle_bounds(m, t)});
-        if (options.self) welded[i] = weld_vertices(m);
-        exact[i] = {&m, object, mesh_bounds(m), {}, {},
-                    options.self ? std::span<const std::uint32_t>(welded[i]) : std::span<const std::uint32_t>()};
+    if (ok) {
+        std::vector<ScanJob> jobs;
+        for (std::size_t i = 0; i < n; ++i) {
+            const auto object = static_cast<std::uint32_t>(i);
+            for (std::size_t f = 0; f < objects[i].triangles.size(); f += kScanChunk)
+                jobs.push_back({object, false, f, std::min(objects[i].triangles.size(), f + kScanChunk)});
+            for (std::size_t f = 0; f < objects[i].positions.size(); f += kScanChunk)
+                jobs.push_back({object, true, f, std::min(objects[i].positions.size(), f + kScanChunk)});
+            boxes[i].resize(objects[i].triangles.size());
+            float_boxes[i].resize(objects[i].triangles.size());
+        }
+        std::vector<unsigned char> job_ok(jobs.size(), 1);
+        std::vector<Aabb> job_box(jobs.size());
+        detail::parallel_chunks(options.threads, jobs.size(), [&](std::size_t j) {
+            const ScanJob& job = jobs[j];
+            const Mesh& m = objects[job.object];
+            if (job.positions) {
+                for (std::size_t v = job.first; v < job.last; ++v)
+                    for (int k = 0; k < 3; ++k)
+                        if (!predicate_coordinate_ok(m.positions[v][k])) job_ok[j] = 0;
+                return;
+            }
+            const std::size_t count = m.positions.size();
+            Aabb& all = job_box[j];
+            all = {{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
+            for (std::size_t t = job.first; t < job.last; ++t) {
+                const Tri& tri = m.triangles[t];
+                if (tri[0] >= count || tri[1] >= count || tri[2] >= count) {
+                    job_ok[j] = 0;
+                    return;
+                }
+                const Vec3& a = m.positions[tri[0]];
+                const Vec3& b = m.positions[tri[1]];
+                const Vec3& c = m.positions[tri[2]];
+                Aabb& box = boxes[job.object][t];
+                for (int k = 0; k < 3; ++k) {
+                    box.lo[k] = std::min({a[k], b[k], c[k]});
+                    box.hi[k] = std::max({a[k], b[k], c[k]});
+                    all.lo[k] = std::min(all.lo[k], box.lo[k]);
+                    all.hi[k] = std::max(all.hi[k], box.hi[k]);
+                }
+                float_boxes[job.object][t] = detail::float_box(box);
+            }
+        });
+        ok = std::all_of(job_ok.begin(), job_ok.end(), [](unsigned char c) { return c != 0; });
+        for (std::size_t j = 0; ok && j < jobs.size(); ++j) {
+            if (jobs[j].positions) continue;
+            Aabb& box = exact[jobs[j].object].box;
+            if (jobs[j].first == 0) {
+                box = job_box[j];
+                continue;
+            }
+            for (int k = 0; k < 3; ++k) {
+                box.lo[k] = std::min(box.lo[k], job_box[j].lo[k]);
+                box.hi[k] = std::max(box.hi[k], job_box[j].hi[k]);
+            }
+        }
     }
-    detail::ExactStageResult r = detail::sweep_exact_stage(exact, sets, {options.self, false, options.threads});
+    if (!ok) {
+        if (Status s = validate_scene(objects); !s) return s.error();
+        if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
+        if (Status s = validate_exact_range(objects); !s) return s.error();
+        return Error{"exact_pairs: the scene check failed but named no problem (a bug)"};
+    }
+
+    // Every triangle is a candidate of its own: the exact stage sweeps them per pair of objects whose
+    // boxes overlap (and per object with self-collision).
+    std::vector<std::vector<std::uint32_t>> welded(options.self ? n : 0);
+    if (options.self) detail::parallel_chunks(options.threads, n, [&](std::size_t i) { welded[i] = weld_vertices(objects[i]); });
+    ExactStats st;
+    for (std::size_t i = 0; i < n; ++i) {
+        st.triangles += objects[i].triangles.size();
+        detail::ExactObject& e = exact[i];
+        e.mesh = &objects[i];
+        e.object = static_cast<std::uint32_t>(i);
+        e.triangle_boxes = boxes[i];
+        if (options.self) e.weld = welded[i];
+    }
+    detail::ExactStageResult r = detail::sweep_exact_triangles(exact, float_boxes, {options.self, false, options.threads});
     st.candidate_triangles = r.stats.task_triangles;
     st.box_pairs = r.stats.tests;
     st.adjacent_skipped = r.stats.adjacent_skipped;
