@@ -494,52 +494,56 @@ GridAxis grid_axis(const Aabb& bounds, int axis, double mean, std::size_t max_ce
     return g;
 }
 
-// The task's axis (its bounds' widest), grid and slabs, from a sample of about 512 triangles per
-// side (they only steer the speed: the pairs found do not depend on them).
-void plan_task(TriTask& t, std::span<const ExactObject> objects) {
+// The task's axis (its bounds' widest), grid and slabs. Its refs are estimated by the triangles of
+// the blocks meeting the common box, their mean extents from about 128 triangles per side (these
+// only steer the speed: the pairs found do not depend on them).
+void plan_task(TriTask& t, std::span<const ExactObject> objects, std::span<const TriangleBoxes> more) {
     const Aabb& bounds = t.self() ? objects[t.a].box : t.common;
     int axis = 0;
     for (int k = 1; k < 3; ++k)
         if (bounds.hi[k] - bounds.lo[k] > bounds.hi[axis] - bounds.lo[axis]) axis = k;
     t.axis = axis;
     const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-    double sum_u = 0.0, sum_v = 0.0, refs = 0.0;
-    std::size_t members = 0;
+    double sum_u = 0.0, sum_v = 0.0;
+    std::size_t members = 0, refs = 0;
     for (const std::uint32_t o : {t.a, t.b}) {
         const std::span<const Aabb> boxes = objects[o].triangle_boxes;
-        const std::size_t stride = std::max<std::size_t>(1, boxes.size() / 512);
-        std::size_t seen = 0, in = 0;
-        for (std::size_t p = 0; p < boxes.size(); p += stride, ++seen) {
+        const std::vector<Aabb>& blocks = more[o].blocks;
+        for (std::size_t b = 0; b < blocks.size(); ++b)
+            if (t.self() || overlaps(blocks[b], bounds)) refs += std::min(kBoxBlock, boxes.size() - b * kBoxBlock);
+        const std::size_t stride = std::max<std::size_t>(1, boxes.size() / 128);
+        for (std::size_t p = 0; p < boxes.size(); p += stride) {
             const Aabb& b = boxes[p];
             if (!t.self() && !overlaps(b, bounds)) continue;
-            ++in;
+            ++members;
             sum_u += std::min(b.hi[u], bounds.hi[u]) - std::max(b.lo[u], bounds.lo[u]);
             sum_v += std::min(b.hi[v], bounds.hi[v]) - std::max(b.lo[v], bounds.lo[v]);
         }
-        members += in;
-        if (seen > 0) refs += static_cast<double>(boxes.size()) * static_cast<double>(in) / static_cast<double>(seen);
         if (t.self()) break;
     }
     const double mean_u = members > 0 ? sum_u / static_cast<double>(members) : 0.0;
     const double mean_v = members > 0 ? sum_v / static_cast<double>(members) : 0.0;
-    const auto budget = std::max<std::size_t>(1, static_cast<std::size_t>(refs) / kRefsPerCell);
+    const auto budget = std::max<std::size_t>(1, refs / kRefsPerCell);
     t.gu = grid_axis(bounds, u, mean_u, budget);
     t.gv = grid_axis(bounds, v, mean_v, std::max<std::size_t>(1, budget / static_cast<std::size_t>(t.gu.cells)));
-    t.slabs = static_cast<int>(std::clamp<std::size_t>(static_cast<std::size_t>(refs) / kSlabRefs, 1,
-                                                       static_cast<std::size_t>(t.gv.cells)));
+    t.slabs = static_cast<int>(std::clamp<std::size_t>(refs / kSlabRefs, 1, static_cast<std::size_t>(t.gv.cells)));
     t.row_slab.resize(static_cast<std::size_t>(t.gv.cells));
     for (int r = 0; r < t.gv.cells; ++r) t.row_slab[static_cast<std::size_t>(r)] = static_cast<std::uint16_t>(r * t.slabs / t.gv.cells);
 }
 
 // Gathers the triangles of one side of a task in positions [first, last) meeting its common box
 // (self: all), into the slabs their rows touch; flags them in `in_task` (pair tasks).
-void gather(const TriTask& t, const ExactObject& o, std::span<const FloatBox> float_boxes, std::uint32_t first,
+void gather(const TriTask& t, const ExactObject& o, const TriangleBoxes& boxes, std::uint32_t first,
             std::uint32_t last, std::span<unsigned char> in_task, SlabRefs& out) {
     out.assign(static_cast<std::size_t>(t.slabs), {});
     const FloatBox common = float_box(t.common);
     const int u = t.gu.axis, v = t.gv.axis;
     for (std::uint32_t p = first; p < last; ++p) {
-        const FloatBox& fb = float_boxes[p];
+        if (!t.self() && p % kBoxBlock == 0 && !overlaps(boxes.blocks[p / kBoxBlock], t.common)) {
+            p += kBoxBlock - 1;  // no triangle of the block meets the common box
+            continue;
+        }
+        const FloatBox& fb = boxes.floats[p];
         if (!t.self()) {
             // The float box holds the double box: disjoint from the common box (rounded outward),
             // the double box is too; otherwise the double box decides.
@@ -752,7 +756,7 @@ ExactStageResult listed_exact_stage(std::span<const ExactObject> objects, std::s
 }
 
 ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
-                                       std::span<const std::vector<FloatBox>> float_boxes, const SweepOptions& options) {
+                                       std::span<const TriangleBoxes> boxes, const SweepOptions& options) {
     const auto n = static_cast<std::uint32_t>(objects.size());
     std::vector<TriTask> tasks;
     if (options.self)
@@ -773,7 +777,7 @@ ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
             tasks.push_back(std::move(t));
         }
     }
-    parallel_chunks(options.threads, tasks.size(), [&](std::size_t t) { plan_task(tasks[t], objects); });
+    parallel_chunks(options.threads, tasks.size(), [&](std::size_t t) { plan_task(tasks[t], objects, boxes); });
 
     // Gather jobs: chunks of each side of each task, side a's then side b's.
     std::vector<GatherJob> jobs;
@@ -798,7 +802,7 @@ ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
         const GatherJob& g = jobs[j];
         const TriTask& t = tasks[g.task];
         const std::uint32_t o = g.side == 0 ? t.a : t.b;
-        gather(t, objects[o], float_boxes[o], g.first, g.last, in_task[o], gathered[j]);
+        gather(t, objects[o], boxes[o], g.first, g.last, in_task[o], gathered[j]);
     });
 
     // Slab jobs.

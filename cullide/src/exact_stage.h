@@ -170,10 +170,16 @@ struct SweepOptions {
 // sweep_exact_stage with one single-triangle set per triangle (task_triangles: triangles meeting
 // some task's common box, all with `self`), on leaner data: float boxes rounded outward in the sweep
 // (exact double boxes decide), and big tasks cut into slabs of grid rows so they spread over threads.
-// float_boxes[o][p]: objects[o].triangle_boxes[p] rounded outward (float_box).
+// What sweep_exact_triangles reads besides an object's triangle_boxes: those boxes rounded outward,
+// and the box of each block of kBoxBlock consecutive triangles (a gather skips a block missing the
+// common box at once: meshes list neighbouring triangles close together).
+inline constexpr std::size_t kBoxBlock = 64;
+struct TriangleBoxes {
+    std::vector<FloatBox> floats;  // floats[p] = float_box(triangle_boxes[p])
+    std::vector<Aabb> blocks;      // blocks[b]: the box of triangles [b * kBoxBlock, (b + 1) * kBoxBlock)
+};
 [[nodiscard]] ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
-                                                     std::span<const std::vector<FloatBox>> float_boxes,
-                                                     const SweepOptions& options);
+                                                     std::span<const TriangleBoxes> boxes, const SweepOptions& options);
 
 // The triangle pairs of exactly the listed set pairs.
 [[nodiscard]] ExactStageResult listed_exact_stage(std::span<const ExactObject> objects,

@@ -83,7 +83,7 @@ struct ScanJob {
     bool positions = false;
     std::size_t first = 0, last = 0;
 };
-constexpr std::size_t kScanChunk = 16384;
+constexpr std::size_t kScanChunk = 16384;  // a multiple of detail::kBoxBlock
 
 }  // namespace
 
@@ -96,7 +96,7 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
     bool ok = std::all_of(objects.begin(), objects.end(), [](const Mesh& m) { return !m.triangles.empty(); }) &&
               n <= UINT32_MAX;
     std::vector<std::vector<Aabb>> boxes(n);
-    std::vector<std::vector<detail::FloatBox>> float_boxes(n);
+    std::vector<detail::TriangleBoxes> more(n);
     std::vector<detail::ExactObject> exact(n);
     if (ok) {
         std::vector<ScanJob> jobs;
@@ -107,7 +107,8 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
             for (std::size_t f = 0; f < objects[i].positions.size(); f += kScanChunk)
                 jobs.push_back({object, true, f, std::min(objects[i].positions.size(), f + kScanChunk)});
             boxes[i].resize(objects[i].triangles.size());
-            float_boxes[i].resize(objects[i].triangles.size());
+            more[i].floats.resize(objects[i].triangles.size());
+            more[i].blocks.resize((objects[i].triangles.size() + detail::kBoxBlock - 1) / detail::kBoxBlock);
         }
         std::vector<unsigned char> job_ok(jobs.size(), 1);
         std::vector<Aabb> job_box(jobs.size());
@@ -139,7 +140,13 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
                     all.lo[k] = std::min(all.lo[k], box.lo[k]);
                     all.hi[k] = std::max(all.hi[k], box.hi[k]);
                 }
-                float_boxes[job.object][t] = detail::float_box(box);
+                more[job.object].floats[t] = detail::float_box(box);
+                Aabb& block = more[job.object].blocks[t / detail::kBoxBlock];
+                if (t % detail::kBoxBlock == 0) block = box;
+                for (int k = 0; k < 3; ++k) {
+                    block.lo[k] = std::min(block.lo[k], box.lo[k]);
+                    block.hi[k] = std::max(block.hi[k], box.hi[k]);
+                }
             }
         });
         ok = std::all_of(job_ok.begin(), job_ok.end(), [](unsigned char c) { return c != 0; });
@@ -176,7 +183,7 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
         e.triangle_boxes = boxes[i];
         if (options.self) e.weld = welded[i];
     }
-    detail::ExactStageResult r = detail::sweep_exact_triangles(exact, float_boxes, {options.self, false, options.threads});
+    detail::ExactStageResult r = detail::sweep_exact_triangles(exact, more, {options.self, false, options.threads});
     st.candidate_triangles = r.stats.task_triangles;
     st.box_pairs = r.stats.tests;
     st.adjacent_skipped = r.stats.adjacent_skipped;
