@@ -508,7 +508,7 @@ void plan_task(TriTask& t, std::span<const ExactObject> objects, std::span<const
     std::size_t members = 0, refs = 0;
     for (const std::uint32_t o : {t.a, t.b}) {
         const std::span<const Aabb> boxes = objects[o].triangle_boxes;
-        const std::vector<Aabb>& blocks = more[o].blocks;
+        const std::span<const Aabb> blocks = more[o].blocks;
         for (std::size_t b = 0; b < blocks.size(); ++b)
             if (t.self() || overlaps(blocks[b], bounds)) refs += std::min(kBoxBlock, boxes.size() - b * kBoxBlock);
         const std::size_t stride = std::max<std::size_t>(1, boxes.size() / 128);

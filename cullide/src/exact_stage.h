@@ -175,8 +175,8 @@ struct SweepOptions {
 // common box at once: meshes list neighbouring triangles close together).
 inline constexpr std::size_t kBoxBlock = 64;
 struct TriangleBoxes {
-    std::vector<FloatBox> floats;  // floats[p] = float_box(triangle_boxes[p])
-    std::vector<Aabb> blocks;      // blocks[b]: the box of triangles [b * kBoxBlock, (b + 1) * kBoxBlock)
+    std::span<const FloatBox> floats;  // floats[p] = float_box(triangle_boxes[p])
+    std::span<const Aabb> blocks;      // blocks[b]: the box of triangles [b * kBoxBlock, (b + 1) * kBoxBlock)
 };
 [[nodiscard]] ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
                                                      std::span<const TriangleBoxes> boxes, const SweepOptions& options);

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <string>
+#include <memory>
 #include <numeric>
+#include <string>
+#include <type_traits>
 
 #include "cullide/predicates.h"
 #include "exact_stage.h"
@@ -85,6 +87,25 @@ struct ScanJob {
 };
 constexpr std::size_t kScanChunk = 16384;  // a multiple of detail::kBoxBlock
 
+// An array the scan jobs construct in place: std::vector's resize would first write every element,
+// on one thread (12 MB on bunny-dragon). Only trivially destructible elements, each constructed by a
+// job before anything reads it.
+template <class T>
+class ScanArray {
+    static_assert(std::is_trivially_destructible_v<T>);
+
+   public:
+    explicit ScanArray(std::size_t n) : size_(std::max<std::size_t>(n, 1)), data_(std::allocator<T>().allocate(size_)) {}
+    ~ScanArray() { std::allocator<T>().deallocate(data_, size_); }
+    ScanArray(const ScanArray&) = delete;
+    ScanArray& operator=(const ScanArray&) = delete;
+    [[nodiscard]] T* data() const { return data_; }
+
+   private:
+    std::size_t size_;
+    T* data_;
+};
+
 }  // namespace
 
 Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, const ExactOptions& options,
@@ -95,8 +116,14 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
     const std::size_t n = objects.size();
     bool ok = std::all_of(objects.begin(), objects.end(), [](const Mesh& m) { return !m.triangles.empty(); }) &&
               n <= UINT32_MAX;
-    std::vector<std::vector<Aabb>> boxes(n);
-    std::vector<detail::TriangleBoxes> more(n);
+    std::vector<std::size_t> first_triangle(n + 1, 0), first_block(n + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        first_triangle[i + 1] = first_triangle[i] + objects[i].triangles.size();
+        first_block[i + 1] = first_block[i] + (objects[i].triangles.size() + detail::kBoxBlock - 1) / detail::kBoxBlock;
+    }
+    ScanArray<Aabb> boxes(ok ? first_triangle[n] : 0);
+    ScanArray<detail::FloatBox> floats(ok ? first_triangle[n] : 0);
+    ScanArray<Aabb> blocks(ok ? first_block[n] : 0);
     std::vector<detail::ExactObject> exact(n);
     if (ok) {
         std::vector<ScanJob> jobs;
@@ -106,9 +133,6 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
                 jobs.push_back({object, false, f, std::min(objects[i].triangles.size(), f + kScanChunk)});
             for (std::size_t f = 0; f < objects[i].positions.size(); f += kScanChunk)
                 jobs.push_back({object, true, f, std::min(objects[i].positions.size(), f + kScanChunk)});
-            boxes[i].resize(objects[i].triangles.size());
-            more[i].floats.resize(objects[i].triangles.size());
-            more[i].blocks.resize((objects[i].triangles.size() + detail::kBoxBlock - 1) / detail::kBoxBlock);
         }
         std::vector<unsigned char> job_ok(jobs.size(), 1);
         std::vector<Aabb> job_box(jobs.size());
@@ -122,32 +146,39 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
                 return;
             }
             const std::size_t count = m.positions.size();
-            Aabb& all = job_box[j];
-            all = {{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
-            for (std::size_t t = job.first; t < job.last; ++t) {
-                const Tri& tri = m.triangles[t];
-                if (tri[0] >= count || tri[1] >= count || tri[2] >= count) {
-                    job_ok[j] = 0;
-                    return;
+            Aabb* const box_out = boxes.data() + first_triangle[job.object];
+            detail::FloatBox* const float_out = floats.data() + first_triangle[job.object];
+            Aabb* const block_out = blocks.data() + first_block[job.object];
+            Aabb all{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
+            for (std::size_t b0 = job.first; b0 < job.last; b0 += detail::kBoxBlock) {
+                Aabb block = all;
+                const std::size_t b1 = std::min(job.last, b0 + detail::kBoxBlock);
+                for (std::size_t t = b0; t < b1; ++t) {
+                    const Tri& tri = m.triangles[t];
+                    if (tri[0] >= count || tri[1] >= count || tri[2] >= count) {
+                        job_ok[j] = 0;
+                        return;
+                    }
+                    const Vec3& a = m.positions[tri[0]];
+                    const Vec3& b = m.positions[tri[1]];
+                    const Vec3& c = m.positions[tri[2]];
+                    Aabb box;
+                    for (int k = 0; k < 3; ++k) {
+                        box.lo[k] = std::min({a[k], b[k], c[k]});
+                        box.hi[k] = std::max({a[k], b[k], c[k]});
+                        block.lo[k] = std::min(block.lo[k], box.lo[k]);
+                        block.hi[k] = std::max(block.hi[k], box.hi[k]);
+                    }
+                    std::construct_at(box_out + t, box);
+                    std::construct_at(float_out + t, detail::float_box(box));
                 }
-                const Vec3& a = m.positions[tri[0]];
-                const Vec3& b = m.positions[tri[1]];
-                const Vec3& c = m.positions[tri[2]];
-                Aabb& box = boxes[job.object][t];
+                std::construct_at(block_out + b0 / detail::kBoxBlock, block);
                 for (int k = 0; k < 3; ++k) {
-                    box.lo[k] = std::min({a[k], b[k], c[k]});
-                    box.hi[k] = std::max({a[k], b[k], c[k]});
-                    all.lo[k] = std::min(all.lo[k], box.lo[k]);
-                    all.hi[k] = std::max(all.hi[k], box.hi[k]);
-                }
-                more[job.object].floats[t] = detail::float_box(box);
-                Aabb& block = more[job.object].blocks[t / detail::kBoxBlock];
-                if (t % detail::kBoxBlock == 0) block = box;
-                for (int k = 0; k < 3; ++k) {
-                    block.lo[k] = std::min(block.lo[k], box.lo[k]);
-                    block.hi[k] = std::max(block.hi[k], box.hi[k]);
+                    all.lo[k] = std::min(all.lo[k], block.lo[k]);
+                    all.hi[k] = std::max(all.hi[k], block.hi[k]);
                 }
             }
+            job_box[j] = all;
         });
         ok = std::all_of(job_ok.begin(), job_ok.end(), [](unsigned char c) { return c != 0; });
         for (std::size_t j = 0; ok && j < jobs.size(); ++j) {
@@ -175,12 +206,16 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
     std::vector<std::vector<std::uint32_t>> welded(options.self ? n : 0);
     if (options.self) detail::parallel_chunks(options.threads, n, [&](std::size_t i) { welded[i] = weld_vertices(objects[i]); });
     ExactStats st;
+    std::vector<detail::TriangleBoxes> more(n);
     for (std::size_t i = 0; i < n; ++i) {
         st.triangles += objects[i].triangles.size();
         detail::ExactObject& e = exact[i];
         e.mesh = &objects[i];
         e.object = static_cast<std::uint32_t>(i);
-        e.triangle_boxes = boxes[i];
+        const std::size_t count = objects[i].triangles.size();
+        e.triangle_boxes = {boxes.data() + first_triangle[i], count};
+        more[i].floats = {floats.data() + first_triangle[i], count};
+        more[i].blocks = {blocks.data() + first_block[i], first_block[i + 1] - first_block[i]};
         if (options.self) e.weld = welded[i];
     }
     detail::ExactStageResult r = detail::sweep_exact_triangles(exact, more, {options.self, false, options.threads});
