@@ -159,18 +159,22 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
                         job_ok[j] = 0;
                         return;
                     }
-                    const Vec3& a = m.positions[tri[0]];
-                    const Vec3& b = m.positions[tri[1]];
-                    const Vec3& c = m.positions[tri[2]];
-                    Aabb box;
-                    for (int k = 0; k < 3; ++k) {
-                        box.lo[k] = std::min({a[k], b[k], c[k]});
-                        box.hi[k] = std::max({a[k], b[k], c[k]});
-                        block.lo[k] = std::min(block.lo[k], box.lo[k]);
-                        block.hi[k] = std::max(block.hi[k], box.hi[k]);
-                    }
-                    std::construct_at(box_out + t, box);
-                    std::construct_at(float_out + t, detail::float_box(box));
+                    const Vec3 a = m.positions[tri[0]];
+                    const Vec3 b = m.positions[tri[1]];
+                    const Vec3 c = m.positions[tri[2]];
+                    // Component by component (Vec3's operator[] branches on the index).
+                    const Vec3 lo{std::min({a.x, b.x, c.x}), std::min({a.y, b.y, c.y}), std::min({a.z, b.z, c.z})};
+                    const Vec3 hi{std::max({a.x, b.x, c.x}), std::max({a.y, b.y, c.y}), std::max({a.z, b.z, c.z})};
+                    block.lo = {std::min(block.lo.x, lo.x), std::min(block.lo.y, lo.y), std::min(block.lo.z, lo.z)};
+                    block.hi = {std::max(block.hi.x, hi.x), std::max(block.hi.y, hi.y), std::max(block.hi.z, hi.z)};
+                    std::construct_at(box_out + t, Aabb{lo, hi});
+                    detail::FloatBox* fb = std::construct_at(float_out + t);
+                    fb->lo[0] = detail::float_down(lo.x);
+                    fb->lo[1] = detail::float_down(lo.y);
+                    fb->lo[2] = detail::float_down(lo.z);
+                    fb->hi[0] = detail::float_up(hi.x);
+                    fb->hi[1] = detail::float_up(hi.y);
+                    fb->hi[2] = detail::float_up(hi.z);
                 }
                 std::construct_at(block_out + b0 / detail::kBoxBlock, block);
                 for (int k = 0; k < 3; ++k) {
