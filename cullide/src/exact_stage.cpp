@@ -440,6 +440,9 @@ struct TriTask {
 
 constexpr std::size_t kGatherChunk = 16384;  // triangles per gather job
 constexpr std::size_t kSlabRefs = 8192;      // about this many refs per slab job
+constexpr std::size_t kSpatialMin = 2048;    // an object worth a spatial order: this many triangles
+constexpr std::uint32_t kSpatialTasks = 8;   // in this many pair tasks (tori: 4-5 tasks an object, 12% slower
+                                             // with the order; leaves: 57, 10% faster)
 
 // The refs a gather job found, per slab of its task.
 using SlabRefs = std::vector<std::vector<TriRef>>;
@@ -533,16 +536,82 @@ void plan_task(TriTask& t, std::span<const ExactObject> objects, std::span<const
 
 // Gathers the triangles of one side of a task in positions [first, last) meeting its common box
 // (self: all), into the slabs their rows touch; flags them in `in_task` (pair tasks).
-void gather(const TriTask& t, const ExactObject& o, const TriangleBoxes& boxes, std::uint32_t first,
-            std::uint32_t last, std::span<unsigned char> in_task, SlabRefs& out) {
+// An object's triangles in a spatial order (Morton order of their box centres, 10 bits an axis over
+// the object's box) with the box of each block of kBoxBlock of them. For an object in several pair
+// tasks, where the mesh's own order leaves blocks loose: the big object of leaves (about 40 K
+// triangles in 57 tasks, 1,764 of them in any common box) had every task read all its triangles.
+struct SpatialOrder {
+    std::vector<std::uint32_t> positions;  // positions in spatial order; empty: the mesh's order
+    std::vector<Aabb> blocks;              // blocks[b]: the box of positions[b * kBoxBlock ...]
+};
+
+// Spreads the 10 low bits of x to every third bit.
+std::uint32_t spread_bits(std::uint32_t x) {
+    x &= 0x3ffu;
+    x = (x | (x << 16)) & 0x030000ffu;
+    x = (x | (x << 8)) & 0x0300f00fu;
+    x = (x | (x << 4)) & 0x030c30c3u;
+    x = (x | (x << 2)) & 0x09249249u;
+    return x;
+}
+
+SpatialOrder spatial_order(const ExactObject& o) {
+    const std::span<const Aabb> boxes = o.triangle_boxes;
+    const std::size_t n = boxes.size();
+    std::array<double, 3> scale{};
+    for (int k = 0; k < 3; ++k) {
+        const double extent = o.box.hi[k] - o.box.lo[k];
+        scale[static_cast<std::size_t>(k)] = extent > 0.0 ? 1023.0 / extent : 0.0;
+    }
+    std::vector<std::uint64_t> a(n), b(n);
+    for (std::size_t p = 0; p < n; ++p) {
+        std::uint32_t code = 0;
+        for (int k = 0; k < 3; ++k) {
+            const double c = 0.5 * boxes[p].lo[k] + 0.5 * boxes[p].hi[k];
+            const double q = std::clamp((c - o.box.lo[k]) * scale[static_cast<std::size_t>(k)], 0.0, 1023.0);
+            code |= spread_bits(static_cast<std::uint32_t>(q)) << k;
+        }
+        a[p] = std::uint64_t{code} << 32 | p;
+    }
+    // Stable LSD radix sort on the 30 code bits, 10 a pass.
+    std::array<std::uint32_t, 1024> count{};
+    for (const unsigned shift : {32u, 42u, 52u}) {
+        count.fill(0);
+        for (const std::uint64_t x : a) ++count[(x >> shift) & 0x3ffu];
+        std::uint32_t sum = 0;
+        for (std::uint32_t& c : count) sum += std::exchange(c, sum);
+        for (const std::uint64_t x : a) b[count[(x >> shift) & 0x3ffu]++] = x;
+        a.swap(b);
+    }
+    SpatialOrder s;
+    s.positions.resize(n);
+    for (std::size_t q = 0; q < n; ++q) s.positions[q] = static_cast<std::uint32_t>(a[q]);
+    s.blocks.resize((n + kBoxBlock - 1) / kBoxBlock);
+    for (std::size_t q = 0; q < n; ++q) {
+        const Aabb& t = boxes[s.positions[q]];
+        Aabb& block = s.blocks[q / kBoxBlock];
+        if (q % kBoxBlock == 0) block = t;
+        for (int k = 0; k < 3; ++k) {
+            block.lo[k] = std::min(block.lo[k], t.lo[k]);
+            block.hi[k] = std::max(block.hi[k], t.hi[k]);
+        }
+    }
+    return s;
+}
+
+void gather(const TriTask& t, const ExactObject& o, const TriangleBoxes& boxes, const SpatialOrder& order,
+            std::uint32_t first, std::uint32_t last, std::span<unsigned char> in_task, SlabRefs& out) {
     out.assign(static_cast<std::size_t>(t.slabs), {});
     const FloatBox common = float_box(t.common);
     const int u = t.gu.axis, v = t.gv.axis;
-    for (std::uint32_t p = first; p < last; ++p) {
-        if (!t.self() && p % kBoxBlock == 0 && !overlaps(boxes.blocks[p / kBoxBlock], t.common)) {
-            p += kBoxBlock - 1;  // no triangle of the block meets the common box
+    const bool spatial = !order.positions.empty();
+    const std::span<const Aabb> blocks = spatial ? std::span<const Aabb>(order.blocks) : boxes.blocks;
+    for (std::uint32_t q = first; q < last; ++q) {
+        if (!t.self() && q % kBoxBlock == 0 && !overlaps(blocks[q / kBoxBlock], t.common)) {
+            q += kBoxBlock - 1;  // no triangle of the block meets the common box
             continue;
         }
+        const std::uint32_t p = spatial ? order.positions[q] : q;
         const FloatBox& fb = boxes.floats[p];
         if (!t.self()) {
             // The float box holds the double box: disjoint from the common box (rounded outward),
@@ -795,6 +864,16 @@ ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
         if (tasks[t].self()) side_b[t] = jobs.size();
     }
     task_jobs[tasks.size()] = jobs.size();
+    // A spatial order for the big objects read by many pair tasks.
+    std::vector<std::uint32_t> pair_tasks(n, 0), to_order;
+    for (const TriTask& t : tasks)
+        if (!t.self()) ++pair_tasks[t.a], ++pair_tasks[t.b];
+    for (std::uint32_t o = 0; o < n; ++o)
+        if (pair_tasks[o] >= kSpatialTasks && objects[o].triangle_boxes.size() >= kSpatialMin) to_order.push_back(o);
+    std::vector<SpatialOrder> orders(n);
+    parallel_chunks(options.threads, to_order.size(), [&](std::size_t i) {
+        orders[to_order[i]] = spatial_order(objects[to_order[i]]);
+    });
     std::vector<std::vector<unsigned char>> in_task(n);
     for (std::uint32_t o = 0; o < n; ++o) in_task[o].assign(objects[o].triangle_boxes.size(), 0);
     std::vector<SlabRefs> gathered(jobs.size());
@@ -802,7 +881,7 @@ ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
         const GatherJob& g = jobs[j];
         const TriTask& t = tasks[g.task];
         const std::uint32_t o = g.side == 0 ? t.a : t.b;
-        gather(t, objects[o], boxes[o], g.first, g.last, in_task[o], gathered[j]);
+        gather(t, objects[o], boxes[o], orders[o], g.first, g.last, in_task[o], gathered[j]);
     });
 
     // Slab jobs.
