@@ -211,6 +211,39 @@ TEST_CASE("the triangle sweep gives the set sweep's pairs and counts where float
     CHECK(tests > 2 * pairs);
 }
 
+TEST_CASE("a big object in many pair tasks (walked in spatial order) gives the set sweep's pairs and counts") {
+    // One object of 3,000 small triangles over the whole scene box and 12 small objects inside it:
+    // the big one is in 12 pair tasks, so its gathers walk it in Morton order (exact_stage.cpp,
+    // kSpatialMin / kSpatialTasks); the triangles come in a scrambled order, as in a mesh whose
+    // blocks are loose.
+    for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+        CAPTURE(seed);
+        std::vector<Mesh> scene = random_scene(seed + 2000, 13, 20, false);
+        test::Rng rng(seed);
+        Mesh& big = scene[0];
+        big.positions.clear();
+        big.triangles.clear();
+        for (std::uint32_t t = 0; t < 3000; ++t) {
+            const Vec3 c{rng.grid(-1, 9, 8), rng.grid(-1, 9, 8), rng.grid(-1, 9, 8)};
+            for (int k = 0; k < 3; ++k)
+                big.positions.push_back(c + Vec3{rng.grid(-0.5, 0.5, 8), rng.grid(-0.5, 0.5, 8), rng.grid(-0.5, 0.5, 8)});
+            big.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
+        }
+        cullide::ExactStats st;
+        auto got = cullide::exact_pairs(scene, {false, 2}, &st);
+        REQUIRE(got.ok());
+        std::vector<std::vector<std::uint32_t>> welded;
+        const cullide::detail::ExactStageResult want = set_sweep(scene, false, welded);
+        CHECK(got.value() == want.pairs);
+        CHECK(got.value() == test::brute_force_pairs(scene, false));
+        CHECK(st.candidate_triangles == want.stats.task_triangles);
+        CHECK(st.box_pairs == want.stats.tests);
+        std::uint64_t with_big = 0;
+        for (const TrianglePair& p : want.pairs) with_big += p.object_a == 0 ? 1 : 0;
+        CHECK(with_big > 20);  // the big object really meets the others
+    }
+}
+
 TEST_CASE("the result is the same for 1, 2, 3 and 8 threads") {
     std::vector<Mesh> scene = random_scene(77, 40, 120, true);
     cullide::ExactStats s1;
