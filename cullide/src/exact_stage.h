@@ -14,8 +14,11 @@
 // exact stage fast; callers only say which sets may meet.
 #pragma once
 
+#include <algorithm>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <utility>
 #include <vector>
@@ -64,6 +67,41 @@ void sweep_overlaps(std::span<const SweepRef> refs, int axis, std::size_t begin,
 // sorted here, along its spread axis.
 [[nodiscard]] std::vector<std::pair<std::uint32_t, std::uint32_t>> overlapping_sets(std::vector<SweepRef> refs,
                                                                                     int threads);
+
+// A box in floats rounded outward (it holds the double box it was made from): a cheap, never-missing
+// filter; float_overlaps(a, b) false means the double boxes are disjoint too.
+struct FloatBox {
+    float lo[3] = {1, 1, 1};
+    float hi[3] = {0, 0, 0};
+};
+
+// The largest float <= x and the smallest float >= x (beyond the float range: +-infinity on the
+// outer side, +-the largest float on the inner one). Branch-free: half of all conversions round the
+// wrong way, so branches on it are mispredicted half the time.
+[[nodiscard]] inline float float_down(double x) {
+    constexpr double kMax = std::numeric_limits<float>::max();
+    const auto f = static_cast<float>(std::clamp(x, -kMax, kMax));
+    // Floats as sign-magnitude integers, mapped to two's complement to step one float down.
+    auto ordered = std::bit_cast<std::int32_t>(f);
+    ordered ^= (ordered >> 31) & 0x7fffffff;
+    ordered -= static_cast<double>(f) > x ? 1 : 0;
+    return std::bit_cast<float>(ordered ^ ((ordered >> 31) & 0x7fffffff));
+}
+[[nodiscard]] inline float float_up(double x) { return -float_down(-x); }
+
+[[nodiscard]] inline FloatBox float_box(const Aabb& b) {
+    FloatBox f;
+    for (int k = 0; k < 3; ++k) {
+        f.lo[k] = float_down(b.lo[k]);
+        f.hi[k] = float_up(b.hi[k]);
+    }
+    return f;
+}
+
+[[nodiscard]] inline bool float_overlaps(const FloatBox& a, const FloatBox& b) {
+    return a.lo[0] <= b.hi[0] && b.lo[0] <= a.hi[0] && a.lo[1] <= b.hi[1] && b.lo[1] <= a.hi[1] &&
+           a.lo[2] <= b.hi[2] && b.lo[2] <= a.hi[2];
+}
 
 // ---- The exact stage -----------------------------------------------------------------------------
 
@@ -126,6 +164,22 @@ struct SweepOptions {
 // either way. A self task (one object's sets) always sweeps its triangles.
 [[nodiscard]] ExactStageResult sweep_exact_stage(std::span<const ExactObject> objects,
                                                  std::span<const CandidateSet> sets, const SweepOptions& options);
+
+// The ground truth's stage: every triangle of every object a candidate of its own (each object's
+// triangle_boxes holds all its triangles' boxes, `order` is empty). The same pairs and statistics as
+// sweep_exact_stage with one single-triangle set per triangle (task_triangles: triangles meeting
+// some task's common box, all with `self`), on leaner data: float boxes rounded outward in the sweep
+// (exact double boxes decide), and big tasks cut into slabs of grid rows so they spread over threads.
+// What sweep_exact_triangles reads besides an object's triangle_boxes: those boxes rounded outward,
+// and the box of each block of kBoxBlock consecutive triangles (a gather skips a block missing the
+// common box at once: meshes list neighbouring triangles close together).
+inline constexpr std::size_t kBoxBlock = 64;
+struct TriangleBoxes {
+    std::span<const FloatBox> floats;  // floats[p] = float_box(triangle_boxes[p])
+    std::span<const Aabb> blocks;      // blocks[b]: the box of triangles [b * kBoxBlock, (b + 1) * kBoxBlock)
+};
+[[nodiscard]] ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
+                                                     std::span<const TriangleBoxes> boxes, const SweepOptions& options);
 
 // The triangle pairs of exactly the listed set pairs.
 [[nodiscard]] ExactStageResult listed_exact_stage(std::span<const ExactObject> objects,

@@ -1,12 +1,16 @@
 #include "cullide/ground_truth.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
-#include <string>
+#include <memory>
 #include <numeric>
+#include <string>
+#include <type_traits>
 
 #include "cullide/predicates.h"
 #include "exact_stage.h"
+#include "parallel.h"
 
 namespace cullide {
 
@@ -72,32 +76,153 @@ Status validate_exact_range(std::span<const Mesh> objects) {
     return {};
 }
 
+namespace {
+
+// One job of exact_pairs' first pass: triangles [first, last) of an object (indices in range, and
+// their boxes) or its positions [first, last) (coordinates in the exact range).
+struct ScanJob {
+    std::uint32_t object = 0;
+    bool positions = false;
+    std::size_t first = 0, last = 0;
+};
+constexpr std::size_t kScanChunk = 16384;  // a multiple of detail::kBoxBlock
+
+// An array the scan jobs construct in place: std::vector's resize would first write every element,
+// on one thread (12 MB on bunny-dragon). Only trivially destructible elements, each constructed by a
+// job before anything reads it.
+template <class T>
+class ScanArray {
+    static_assert(std::is_trivially_destructible_v<T>);
+
+   public:
+    explicit ScanArray(std::size_t n) : size_(std::max<std::size_t>(n, 1)), data_(std::allocator<T>().allocate(size_)) {}
+    ~ScanArray() { std::allocator<T>().deallocate(data_, size_); }
+    ScanArray(const ScanArray&) = delete;
+    ScanArray& operator=(const ScanArray&) = delete;
+    [[nodiscard]] T* data() const { return data_; }
+
+   private:
+    std::size_t size_;
+    T* data_;
+};
+
+}  // namespace
+
 Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, const ExactOptions& options,
                                               ExactStats* stats) {
-    if (Status s = validate_scene(objects); !s) return s.error();
-    if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
-    if (Status s = validate_exact_range(objects); !s) return s.error();
-
-    // Every triangle is a candidate set of its own (so the exact stage needs no separate list of
-    // triangle boxes): it sweeps them per pair of objects whose boxes overlap (and per object with
-    // self-collision).
+    // One parallel pass checks the scene (indices, coordinates in the exact range) and computes every
+    // triangle's box and every object's box (mesh_bounds: the union of its triangles' boxes). When it
+    // finds a problem, the serial checks name the first one, with the messages they always give.
     const std::size_t n = objects.size();
-    std::vector<std::vector<std::uint32_t>> welded(options.self ? n : 0);
-    std::vector<detail::ExactObject> exact(n);
-    std::vector<detail::CandidateSet> sets;
-    ExactStats st;
-    for (const Mesh& m : objects) st.triangles += m.triangles.size();
-    sets.reserve(st.triangles);
+    bool ok = std::all_of(objects.begin(), objects.end(), [](const Mesh& m) { return !m.triangles.empty(); }) &&
+              n <= UINT32_MAX;
+    std::vector<std::size_t> first_triangle(n + 1, 0), first_block(n + 1, 0);
     for (std::size_t i = 0; i < n; ++i) {
-        const Mesh& m = objects[i];
-        const auto object = static_cast<std::uint32_t>(i);
-        for (std::size_t t = 0; t < m.triangles.size(); ++t)
-            sets.push_back({object, static_cast<std::uint32_t>(t), 1, triangle_bounds(m, t)});
-        if (options.self) welded[i] = weld_vertices(m);
-        exact[i] = {&m, object, mesh_bounds(m), {}, {},
-                    options.self ? std::span<const std::uint32_t>(welded[i]) : std::span<const std::uint32_t>()};
+        first_triangle[i + 1] = first_triangle[i] + objects[i].triangles.size();
+        first_block[i + 1] = first_block[i] + (objects[i].triangles.size() + detail::kBoxBlock - 1) / detail::kBoxBlock;
     }
-    detail::ExactStageResult r = detail::sweep_exact_stage(exact, sets, {options.self, false, options.threads});
+    ScanArray<Aabb> boxes(ok ? first_triangle[n] : 0);
+    ScanArray<detail::FloatBox> floats(ok ? first_triangle[n] : 0);
+    ScanArray<Aabb> blocks(ok ? first_block[n] : 0);
+    std::vector<detail::ExactObject> exact(n);
+    if (ok) {
+        std::vector<ScanJob> jobs;
+        for (std::size_t i = 0; i < n; ++i) {
+            const auto object = static_cast<std::uint32_t>(i);
+            for (std::size_t f = 0; f < objects[i].triangles.size(); f += kScanChunk)
+                jobs.push_back({object, false, f, std::min(objects[i].triangles.size(), f + kScanChunk)});
+            for (std::size_t f = 0; f < objects[i].positions.size(); f += kScanChunk)
+                jobs.push_back({object, true, f, std::min(objects[i].positions.size(), f + kScanChunk)});
+        }
+        std::vector<unsigned char> job_ok(jobs.size(), 1);
+        std::vector<Aabb> job_box(jobs.size());
+        detail::parallel_chunks(options.threads, jobs.size(), [&](std::size_t j) {
+            const ScanJob& job = jobs[j];
+            const Mesh& m = objects[job.object];
+            if (job.positions) {
+                for (std::size_t v = job.first; v < job.last; ++v)
+                    for (int k = 0; k < 3; ++k)
+                        if (!predicate_coordinate_ok(m.positions[v][k])) job_ok[j] = 0;
+                return;
+            }
+            const std::size_t count = m.positions.size();
+            Aabb* const box_out = boxes.data() + first_triangle[job.object];
+            detail::FloatBox* const float_out = floats.data() + first_triangle[job.object];
+            Aabb* const block_out = blocks.data() + first_block[job.object];
+            Aabb all{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
+            for (std::size_t b0 = job.first; b0 < job.last; b0 += detail::kBoxBlock) {
+                Aabb block = all;
+                const std::size_t b1 = std::min(job.last, b0 + detail::kBoxBlock);
+                for (std::size_t t = b0; t < b1; ++t) {
+                    const Tri& tri = m.triangles[t];
+                    if (tri[0] >= count || tri[1] >= count || tri[2] >= count) {
+                        job_ok[j] = 0;
+                        return;
+                    }
+                    const Vec3 a = m.positions[tri[0]];
+                    const Vec3 b = m.positions[tri[1]];
+                    const Vec3 c = m.positions[tri[2]];
+                    // Component by component (Vec3's operator[] branches on the index).
+                    const Vec3 lo{std::min({a.x, b.x, c.x}), std::min({a.y, b.y, c.y}), std::min({a.z, b.z, c.z})};
+                    const Vec3 hi{std::max({a.x, b.x, c.x}), std::max({a.y, b.y, c.y}), std::max({a.z, b.z, c.z})};
+                    block.lo = {std::min(block.lo.x, lo.x), std::min(block.lo.y, lo.y), std::min(block.lo.z, lo.z)};
+                    block.hi = {std::max(block.hi.x, hi.x), std::max(block.hi.y, hi.y), std::max(block.hi.z, hi.z)};
+                    std::construct_at(box_out + t, Aabb{lo, hi});
+                    detail::FloatBox* fb = std::construct_at(float_out + t);
+                    fb->lo[0] = detail::float_down(lo.x);
+                    fb->lo[1] = detail::float_down(lo.y);
+                    fb->lo[2] = detail::float_down(lo.z);
+                    fb->hi[0] = detail::float_up(hi.x);
+                    fb->hi[1] = detail::float_up(hi.y);
+                    fb->hi[2] = detail::float_up(hi.z);
+                }
+                std::construct_at(block_out + b0 / detail::kBoxBlock, block);
+                for (int k = 0; k < 3; ++k) {
+                    all.lo[k] = std::min(all.lo[k], block.lo[k]);
+                    all.hi[k] = std::max(all.hi[k], block.hi[k]);
+                }
+            }
+            job_box[j] = all;
+        });
+        ok = std::all_of(job_ok.begin(), job_ok.end(), [](unsigned char c) { return c != 0; });
+        for (std::size_t j = 0; ok && j < jobs.size(); ++j) {
+            if (jobs[j].positions) continue;
+            Aabb& box = exact[jobs[j].object].box;
+            if (jobs[j].first == 0) {
+                box = job_box[j];
+                continue;
+            }
+            for (int k = 0; k < 3; ++k) {
+                box.lo[k] = std::min(box.lo[k], job_box[j].lo[k]);
+                box.hi[k] = std::max(box.hi[k], job_box[j].hi[k]);
+            }
+        }
+    }
+    if (!ok) {
+        if (Status s = validate_scene(objects); !s) return s.error();
+        if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
+        if (Status s = validate_exact_range(objects); !s) return s.error();
+        return Error{"exact_pairs: the scene check failed but named no problem (a bug)"};
+    }
+
+    // Every triangle is a candidate of its own: the exact stage sweeps them per pair of objects whose
+    // boxes overlap (and per object with self-collision).
+    std::vector<std::vector<std::uint32_t>> welded(options.self ? n : 0);
+    if (options.self) detail::parallel_chunks(options.threads, n, [&](std::size_t i) { welded[i] = weld_vertices(objects[i]); });
+    ExactStats st;
+    std::vector<detail::TriangleBoxes> more(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        st.triangles += objects[i].triangles.size();
+        detail::ExactObject& e = exact[i];
+        e.mesh = &objects[i];
+        e.object = static_cast<std::uint32_t>(i);
+        const std::size_t count = objects[i].triangles.size();
+        e.triangle_boxes = {boxes.data() + first_triangle[i], count};
+        more[i].floats = {floats.data() + first_triangle[i], count};
+        more[i].blocks = {blocks.data() + first_block[i], first_block[i + 1] - first_block[i]};
+        if (options.self) e.weld = welded[i];
+    }
+    detail::ExactStageResult r = detail::sweep_exact_triangles(exact, more, {options.self, false, options.threads});
     st.candidate_triangles = r.stats.task_triangles;
     st.box_pairs = r.stats.tests;
     st.adjacent_skipped = r.stats.adjacent_skipped;

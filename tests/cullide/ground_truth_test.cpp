@@ -3,14 +3,18 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <bit>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <vector>
 
 #include "cullide/ground_truth.h"
 #include "cullide/mesh_io.h"
 #include "cullide/tri_tri.h"
 #include "brute_force_pairs.h"
+#include "exact_stage.h"
 #include "test_rng.h"
 
 using cullide::Mesh;
@@ -118,6 +122,126 @@ TEST_CASE("touching objects collide: a shared vertex between two objects is a pa
     REQUIRE(r.ok());
     CHECK(r.value() == std::vector<TrianglePair>{{0, 0, 1, 0}});
     CHECK(cullide::object_pairs(r.value()) == std::vector<cullide::ObjectPair>{{0, 1}});
+}
+
+namespace {
+
+// The exact stage's general set sweep with one set per triangle: the ground truth's path before
+// sweep_exact_triangles, an independent prefilter on double boxes only.
+cullide::detail::ExactStageResult set_sweep(const std::vector<Mesh>& scene, bool self,
+                                            std::vector<std::vector<std::uint32_t>>& welded) {
+    std::vector<cullide::detail::ExactObject> exact(scene.size());
+    std::vector<cullide::detail::CandidateSet> sets;
+    welded.assign(scene.size(), {});
+    for (std::size_t i = 0; i < scene.size(); ++i) {
+        const auto object = static_cast<std::uint32_t>(i);
+        for (std::size_t t = 0; t < scene[i].triangles.size(); ++t)
+            sets.push_back({object, static_cast<std::uint32_t>(t), 1, cullide::triangle_bounds(scene[i], t)});
+        if (self) welded[i] = cullide::weld_vertices(scene[i]);
+        exact[i] = {&scene[i], object, cullide::mesh_bounds(scene[i]), {}, {}, welded[i]};
+    }
+    return cullide::detail::sweep_exact_stage(exact, sets, {self, false, 1});
+}
+
+}  // namespace
+
+TEST_CASE("float_down and float_up give the nearest floats below and above, infinities beyond the range") {
+    using cullide::detail::float_down;
+    using cullide::detail::float_up;
+    const auto check = [](double x) {
+        CAPTURE(x);
+        const float d = float_down(x), u = float_up(x);
+        REQUIRE(static_cast<double>(d) <= x);
+        REQUIRE(static_cast<double>(u) >= x);
+        // Nearest: the next float beyond each is on the other side of x (or d, u are infinite).
+        constexpr float kInf = std::numeric_limits<float>::infinity();
+        if (!std::isinf(d)) REQUIRE(static_cast<double>(std::nextafter(d, kInf)) > x);
+        if (!std::isinf(u)) REQUIRE(static_cast<double>(std::nextafter(u, -kInf)) < x);
+        if (static_cast<double>(static_cast<float>(x)) == x) REQUIRE((d == u && d == static_cast<float>(x)));
+    };
+    const double flt_max = std::numeric_limits<float>::max();
+    for (double x : {0.0, -0.0, 1.0, -1.0, 0.1, -0.1, 1e-300, -1e-300, 1e-45, -1e-45, 1e300, -1e300, flt_max,
+                     -flt_max, std::nextafter(flt_max, 1e300), -std::nextafter(flt_max, 1e300), 0x1p-149, 0x1.8p-149})
+        check(x);
+    CHECK(float_up(1e300) == std::numeric_limits<float>::infinity());
+    CHECK(float_down(1e300) == std::numeric_limits<float>::max());
+    CHECK(float_down(-1e300) == -std::numeric_limits<float>::infinity());
+    CHECK(float_down(-1e-300) == -std::numeric_limits<float>::denorm_min());
+    CHECK(float_up(1e-300) == std::numeric_limits<float>::denorm_min());
+    test::Rng rng(11);
+    for (int i = 0; i < 200000; ++i) {
+        double x = std::bit_cast<double>(rng.next());
+        if (std::isfinite(x)) check(x);
+        check(std::ldexp(rng.sym(), static_cast<int>(rng.below(320)) - 160));
+    }
+}
+
+TEST_CASE("the triangle sweep gives the set sweep's pairs and counts where floats cannot hold the boxes") {
+    // Coordinates a tiny step (2^-30, far below a float's spacing near 8) off the dyadic grid, so
+    // that boxes a float cannot tell apart are disjoint or touching in doubles; and whole scenes
+    // scaled beyond the float range (2^200) and below it (2^-200), where the float boxes are
+    // infinite or zero-sized. The double boxes must decide every count.
+    std::uint64_t pairs = 0, tests = 0;
+    for (std::uint64_t seed = 1; seed <= 120; ++seed) {
+        CAPTURE(seed);
+        const bool self = seed % 2 == 0;
+        std::vector<Mesh> scene = random_scene(seed + 1000, 2 + static_cast<int>(seed % 4), 20, self);
+        test::Rng rng(seed);
+        for (Mesh& m : scene)
+            for (Vec3& p : m.positions)
+                for (int k = 0; k < 3; ++k) p[k] += static_cast<double>(static_cast<int>(rng.below(3)) - 1) * 0x1p-30;
+        const double scale = seed % 3 == 0 ? 0x1p200 : seed % 3 == 1 ? 0x1p-200 : 1.0;
+        for (Mesh& m : scene)
+            for (Vec3& p : m.positions)
+                for (int k = 0; k < 3; ++k) p[k] *= scale;
+        cullide::ExactStats st;
+        auto got = cullide::exact_pairs(scene, {self, 1 + static_cast<int>(seed % 3)}, &st);
+        REQUIRE(got.ok());
+        std::vector<std::vector<std::uint32_t>> welded;
+        const cullide::detail::ExactStageResult want = set_sweep(scene, self, welded);
+        CHECK(got.value() == want.pairs);
+        CHECK(got.value() == test::brute_force_pairs(scene, self));
+        CHECK(st.candidate_triangles == want.stats.task_triangles);
+        CHECK(st.box_pairs == want.stats.tests);
+        CHECK(st.adjacent_skipped == want.stats.adjacent_skipped);
+        pairs += want.pairs.size();
+        tests += want.stats.tests;
+    }
+    CHECK(pairs > 500);
+    CHECK(tests > 2 * pairs);
+}
+
+TEST_CASE("a big object in many pair tasks (walked in spatial order) gives the set sweep's pairs and counts") {
+    // One object of 3,000 small triangles over the whole scene box and 12 small objects inside it:
+    // the big one is in 12 pair tasks, so its gathers walk it in Morton order (exact_stage.cpp,
+    // kSpatialMin / kSpatialTasks); the triangles come in a scrambled order, as in a mesh whose
+    // blocks are loose.
+    for (std::uint64_t seed = 1; seed <= 4; ++seed) {
+        CAPTURE(seed);
+        std::vector<Mesh> scene = random_scene(seed + 2000, 13, 20, false);
+        test::Rng rng(seed);
+        Mesh& big = scene[0];
+        big.positions.clear();
+        big.triangles.clear();
+        for (std::uint32_t t = 0; t < 3000; ++t) {
+            const Vec3 c{rng.grid(-1, 9, 8), rng.grid(-1, 9, 8), rng.grid(-1, 9, 8)};
+            for (int k = 0; k < 3; ++k)
+                big.positions.push_back(c + Vec3{rng.grid(-0.5, 0.5, 8), rng.grid(-0.5, 0.5, 8), rng.grid(-0.5, 0.5, 8)});
+            big.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
+        }
+        cullide::ExactStats st;
+        auto got = cullide::exact_pairs(scene, {false, 2}, &st);
+        REQUIRE(got.ok());
+        std::vector<std::vector<std::uint32_t>> welded;
+        const cullide::detail::ExactStageResult want = set_sweep(scene, false, welded);
+        CHECK(got.value() == want.pairs);
+        CHECK(got.value() == test::brute_force_pairs(scene, false));
+        CHECK(st.candidate_triangles == want.stats.task_triangles);
+        CHECK(st.box_pairs == want.stats.tests);
+        std::uint64_t with_big = 0;
+        for (const TrianglePair& p : want.pairs) with_big += p.object_a == 0 ? 1 : 0;
+        CHECK(with_big > 20);  // the big object really meets the others
+    }
 }
 
 TEST_CASE("the result is the same for 1, 2, 3 and 8 threads") {
