@@ -4,7 +4,8 @@
 // edges through centres, fans and grids with shared edges, slivers, off-screen, near/far-crossing
 // and w < 0 triangles, culling, small viewports, equal-depth ties under every depth function) are
 // run through raster::execute_reference and through OSMesa; every query result and every depth
-// value must be equal, in D16, D24 and D32F. CULLIDE_CONFORMANCE_SCALE=<n> multiplies the number
+// value must be equal, in D16, D24 and D32F (conformance_harness.h; the tiled executor must give the
+// reference's bits as well). CULLIDE_CONFORMANCE_SCALE=<n> multiplies the number
 // of scenes (default 1: about 110,000 queries).
 #include <doctest/doctest.h>
 
@@ -14,85 +15,22 @@
 
 #include "osmesa_device.h"
 #include "raster/raster.h"
-#include "scene_gen.h"
+#include "conformance_harness.h"
 
 namespace {
 
-int scale_factor() {
-    const char* s = std::getenv("CULLIDE_CONFORMANCE_SCALE");
-    if (s == nullptr) return 1;
-    const int v = std::atoi(s);
-    return v < 1 ? 1 : v;
-}
+using raster_test::ConformanceTally;
+using raster_test::format_name;
 
-const char* format_name(raster::DepthFormat f) {
-    return f == raster::DepthFormat::D16 ? "D16" : f == raster::DepthFormat::D24 ? "D24" : "D32F";
-}
-
-struct Tally {
-    std::size_t queries = 0, query_mismatches = 0, pixels = 0, pixel_mismatches = 0;
-};
-
-// Runs `scenes` random scenes of one format and size; returns the tallies. Prints the first
-// mismatch of each kind (what a human needs to reproduce it: seed, scene, query or pixel).
-Tally run_format(raster::DepthFormat format, int width, int height, int scenes, std::uint64_t seed) {
-    Tally t;
-    auto dev = cullide_oracle::OsmesaDevice::create(width, height, format);
-    REQUIRE_MESSAGE(dev.ok(), (dev.ok() ? "" : dev.error().message));
-    raster_test::SplitMix64 rng(seed);
-    raster_test::Scene scene;
-    bool reported_query = false, reported_pixel = false;
-    for (int s = 0; s < scenes; ++s) {
-        raster_test::SceneOptions o;
-        o.width = width;
-        o.height = height;
-        raster_test::build_scene(scene, rng, o);
-        dev.value()->clear(scene.clear_depth);
-        auto gl = dev.value()->run(scene.batch);
-        REQUIRE_MESSAGE(gl.ok(), (gl.ok() ? "" : gl.error().message));
-        const auto gl_depth = dev.value()->read_depth();
-
-        auto target = raster::DepthTarget::create(width, height, format);
-        REQUIRE(target.ok());
-        REQUIRE(target.value().clear(scene.clear_depth).ok());
-        auto ours = raster::execute_reference(target.value(), scene.batch);
-        REQUIRE_MESSAGE(ours.ok(), (ours.ok() ? "" : ours.error().message));
-        REQUIRE(ours.value().size() == gl.value().size());
-        for (std::size_t q = 0; q < ours.value().size(); ++q) {
-            ++t.queries;
-            if (ours.value()[q] != gl.value()[q]) {
-                ++t.query_mismatches;
-                if (!reported_query) {
-                    reported_query = true;
-                    std::printf("[%s %dx%d seed %llu] scene %d query %zu: ours %llu, GL %llu\n", format_name(format),
-                                width, height, static_cast<unsigned long long>(seed), s, q,
-                                static_cast<unsigned long long>(ours.value()[q]),
-                                static_cast<unsigned long long>(gl.value()[q]));
-                }
-            }
-        }
-        const auto mine = target.value().values();
-        for (std::size_t i = 0; i < mine.size(); ++i) {
-            ++t.pixels;
-            if (mine[i] != gl_depth[i]) {
-                ++t.pixel_mismatches;
-                if (!reported_pixel) {
-                    reported_pixel = true;
-                    std::printf("[%s %dx%d seed %llu] scene %d pixel (%zu, %zu): ours %08x, GL %08x\n",
-                                format_name(format), width, height, static_cast<unsigned long long>(seed), s,
-                                i % static_cast<std::size_t>(width), i / static_cast<std::size_t>(width), mine[i],
-                                gl_depth[i]);
-                }
-            }
-        }
-    }
-    return t;
+ConformanceTally run_format(raster::DepthFormat format, int width, int height, int scenes, std::uint64_t seed) {
+    return raster_test::run_conformance<cullide_oracle::OsmesaDevice>("GL", raster::RasterRules::GlLlvmpipe, format,
+                                                                      width, height, scenes, seed);
 }
 
 }  // namespace
 
 TEST_CASE("Random scenes give exactly OSMesa llvmpipe's query counts and depth buffers in every format") {
-    const int scale = scale_factor();
+    const int scale = raster_test::conformance_scale();
     struct Size {
         int w, h, scenes;
     };
@@ -101,20 +39,17 @@ TEST_CASE("Random scenes give exactly OSMesa llvmpipe's query counts and depth b
     const Size sizes[] = {{64, 64, 100}, {97, 61, 100}, {128, 96, 100}, {1024, 768, 10}};
     const raster::DepthFormat formats[] = {raster::DepthFormat::D16, raster::DepthFormat::D24,
                                            raster::DepthFormat::D32F};
-    Tally total;
+    ConformanceTally total;
     std::uint64_t seed = 1234;
     for (const auto f : formats) {
         for (const auto& sz : sizes) {
             CAPTURE(format_name(f));
             CAPTURE(sz.w);
             CAPTURE(sz.h);
-            const Tally t = run_format(f, sz.w, sz.h, sz.scenes * scale, seed++);
+            const ConformanceTally t = run_format(f, sz.w, sz.h, sz.scenes * scale, seed++);
             CHECK(t.query_mismatches == 0);
             CHECK(t.pixel_mismatches == 0);
-            total.queries += t.queries;
-            total.query_mismatches += t.query_mismatches;
-            total.pixels += t.pixels;
-            total.pixel_mismatches += t.pixel_mismatches;
+            total.add(t);
         }
     }
     std::printf("conformance: %zu queries (%zu differ), %zu depth values (%zu differ)\n", total.queries,

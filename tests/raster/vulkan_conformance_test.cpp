@@ -17,7 +17,7 @@
 #include <string>
 
 #include "raster/raster.h"
-#include "scene_gen.h"
+#include "conformance_harness.h"
 #include "vulkan_device.h"
 
 #ifndef CULLIDE_VULKAN_CONFORMANCE_FULL
@@ -26,93 +26,22 @@
 
 namespace {
 
-int scale_factor() {
-    const char* s = std::getenv("CULLIDE_CONFORMANCE_SCALE");
-    if (s == nullptr) return 1;
-    const int v = std::atoi(s);
-    return v < 1 ? 1 : v;
-}
+using raster_test::ConformanceTally;
+using raster_test::format_name;
 
-const char* format_name(raster::DepthFormat f) {
-    return f == raster::DepthFormat::D16 ? "D16" : f == raster::DepthFormat::D24 ? "D24" : "D32F";
-}
-
-struct Tally {
-    std::size_t queries = 0, query_mismatches = 0, pixels = 0, pixel_mismatches = 0;
-};
-
-// Runs `scenes` random scenes of one format and size; returns the tallies. Prints the first
-// mismatch of each kind (seed, scene, query or pixel), enough to reproduce it.
-Tally run_format(raster::DepthFormat format, int width, int height, int scenes, std::uint64_t seed) {
-    Tally t;
-    auto dev = cullide_oracle::VulkanDevice::create(width, height, format);
-    REQUIRE_MESSAGE(dev.ok(), (dev.ok() ? "" : dev.error().message));
-    if (width == 64) std::printf("lavapipe: %s\n", dev.value()->renderer().c_str());
-    raster_test::SplitMix64 rng(seed);
-    raster_test::Scene scene;
-    bool reported_query = false, reported_pixel = false;
-    for (int s = 0; s < scenes; ++s) {
-        raster_test::SceneOptions o;
-        o.width = width;
-        o.height = height;
-        o.rules = raster::RasterRules::Vulkan;
-        raster_test::build_scene(scene, rng, o);
-        dev.value()->clear(scene.clear_depth);
-        auto vk = dev.value()->run(scene.batch);
-        REQUIRE_MESSAGE(vk.ok(), (vk.ok() ? "" : vk.error().message));
-        const auto vk_depth = dev.value()->read_depth();
-
-        auto target = raster::DepthTarget::create(width, height, format);
-        REQUIRE(target.ok());
-        REQUIRE(target.value().clear(scene.clear_depth).ok());
-        auto ours = raster::execute_reference(target.value(), scene.batch);
-        REQUIRE_MESSAGE(ours.ok(), (ours.ok() ? "" : ours.error().message));
-        REQUIRE(ours.value().size() == vk.value().size());
-        // The tiled executor (3 threads, SIMD kernel where available) gives the reference's bits under
-        // these rules too.
-        auto tiled = raster::DepthTarget::create(width, height, format);
-        REQUIRE(tiled.ok());
-        REQUIRE(tiled.value().clear(scene.clear_depth).ok());
-        auto tiled_results = raster::execute(tiled.value(), scene.batch, {3, true});
-        REQUIRE(tiled_results.ok());
-        CHECK(tiled_results.value() == ours.value());
-        CHECK(std::equal(tiled.value().values().begin(), tiled.value().values().end(),
-                         target.value().values().begin()));
-        for (std::size_t q = 0; q < ours.value().size(); ++q) {
-            ++t.queries;
-            if (ours.value()[q] != vk.value()[q]) {
-                ++t.query_mismatches;
-                if (!reported_query) {
-                    reported_query = true;
-                    std::printf("[%s %dx%d seed %llu] scene %d query %zu: ours %llu, lavapipe %llu\n",
-                                format_name(format), width, height, static_cast<unsigned long long>(seed), s, q,
-                                static_cast<unsigned long long>(ours.value()[q]),
-                                static_cast<unsigned long long>(vk.value()[q]));
-                }
-            }
-        }
-        const auto mine = target.value().values();
-        for (std::size_t i = 0; i < mine.size(); ++i) {
-            ++t.pixels;
-            if (mine[i] != vk_depth[i]) {
-                ++t.pixel_mismatches;
-                if (!reported_pixel) {
-                    reported_pixel = true;
-                    std::printf("[%s %dx%d seed %llu] scene %d pixel (%zu, %zu): ours %08x, lavapipe %08x\n",
-                                format_name(format), width, height, static_cast<unsigned long long>(seed), s,
-                                i % static_cast<std::size_t>(width), i / static_cast<std::size_t>(width), mine[i],
-                                vk_depth[i]);
-                }
-            }
-        }
+ConformanceTally run_format(raster::DepthFormat format, int width, int height, int scenes, std::uint64_t seed) {
+    if (width == 64) {
+        auto dev = cullide_oracle::VulkanDevice::create(width, height, format);
+        if (dev.ok()) std::printf("lavapipe: %s\n", dev.value()->renderer().c_str());
     }
-    return t;
+    return raster_test::run_conformance<cullide_oracle::VulkanDevice>("lavapipe", raster::RasterRules::Vulkan, format,
+                                                                      width, height, scenes, seed);
 }
 
 }  // namespace
 
 TEST_CASE("Random Vulkan-rules scenes give exactly lavapipe's query counts and depth buffers in every format") {
-    const int scale = scale_factor();
+    const int scale = raster_test::conformance_scale();
     // The OSMesa suite's sizes and scene counts; the default (non-slow) program runs a tenth.
     const int divisor = CULLIDE_VULKAN_CONFORMANCE_FULL ? 1 : 10;
     struct Size {
@@ -121,7 +50,7 @@ TEST_CASE("Random Vulkan-rules scenes give exactly lavapipe's query counts and d
     const Size sizes[] = {{64, 64, 100}, {97, 61, 100}, {128, 96, 100}, {1024, 768, 10}};
     const raster::DepthFormat formats[] = {raster::DepthFormat::D16, raster::DepthFormat::D24,
                                            raster::DepthFormat::D32F};
-    Tally total;
+    ConformanceTally total;
     std::uint64_t seed = CULLIDE_VULKAN_CONFORMANCE_FULL ? 5678 : 8765;
     for (const auto f : formats) {
         for (const auto& sz : sizes) {
@@ -129,13 +58,10 @@ TEST_CASE("Random Vulkan-rules scenes give exactly lavapipe's query counts and d
             CAPTURE(sz.w);
             CAPTURE(sz.h);
             const int scenes = std::max(1, sz.scenes * scale / divisor);
-            const Tally t = run_format(f, sz.w, sz.h, scenes, seed++);
+            const ConformanceTally t = run_format(f, sz.w, sz.h, scenes, seed++);
             CHECK(t.query_mismatches == 0);
             CHECK(t.pixel_mismatches == 0);
-            total.queries += t.queries;
-            total.query_mismatches += t.query_mismatches;
-            total.pixels += t.pixels;
-            total.pixel_mismatches += t.pixel_mismatches;
+            total.add(t);
         }
     }
     std::printf("vulkan conformance: %zu queries (%zu differ), %zu depth values (%zu differ)\n", total.queries,
