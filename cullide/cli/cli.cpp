@@ -20,7 +20,6 @@
 #include "cullide/scenes.h"
 
 namespace cullide::cli {
-namespace {
 
 std::string json_escape(const std::string& s) {
     std::string o;
@@ -38,6 +37,8 @@ std::string json_escape(const std::string& s) {
     }
     return o;
 }
+
+namespace {
 
 struct RunArgs {
     std::vector<std::string> scene;

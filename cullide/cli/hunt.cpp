@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "bench.h"
+#include "cli.h"
 #include "cullide/hunt.h"
 #include "cullide/mesh_io.h"
 #include "cullide/pipeline.h"
@@ -55,23 +56,6 @@ class SigintScope {
 struct Failure {  // a file that cannot be read or written, a frame the pipeline refuses
     std::string message;
 };
-
-std::string json_escape(const std::string& s) {
-    std::string o;
-    for (char c : s) {
-        if (c == '"' || c == '\\') {
-            o += '\\';
-            o += c;
-        } else if (static_cast<unsigned char>(c) < 0x20) {
-            char buf[8];
-            std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned>(static_cast<unsigned char>(c)));
-            o += buf;
-        } else {
-            o += c;
-        }
-    }
-    return o;
-}
 
 // A word for a POSIX shell: as it is when it is plain, else in single quotes.
 std::string shell_word(const std::string& s) {

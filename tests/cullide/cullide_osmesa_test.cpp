@@ -9,24 +9,9 @@
 #include "cullide/pipeline.h"
 #include "cullide/scenes.h"
 #include "osmesa_query_device.h"
+#include "same_frame.h"
 
-namespace {
-
-void check_same(const cullide::FrameResult& gl, const cullide::FrameResult& emu) {
-    CHECK(gl.pairs == emu.pairs);
-    CHECK(gl.stats.queries == emu.stats.queries);
-    CHECK(gl.stats.triangles_rasterized == emu.stats.triangles_rasterized);
-    CHECK(gl.stats.pcs_boxes == emu.stats.pcs_boxes);
-    CHECK(gl.stats.pcs_objects == emu.stats.pcs_objects);
-    CHECK(gl.stats.pcs_subobjects == emu.stats.pcs_subobjects);
-    REQUIRE(gl.stats.views.size() == emu.stats.views.size());
-    for (std::size_t v = 0; v < gl.stats.views.size(); ++v) {
-        CAPTURE(v);
-        CHECK(gl.stats.views[v].items_after == emu.stats.views[v].items_after);
-    }
-}
-
-}  // namespace
+using cullide_test::check_same_frame;
 
 TEST_CASE("cullide and rcullide-offset prune the same on OSMesa as on the emulator, on every built-in scene") {
     auto device = cullide_oracle::make_osmesa_query_device();
@@ -59,7 +44,7 @@ TEST_CASE("cullide and rcullide-offset prune the same on OSMesa as on the emulat
                     o.device = device.value().get();
                     auto gl = cullide::process_frame(objects, o);
                     REQUIRE(gl.ok());
-                    check_same(gl.value(), emu.value());
+                    check_same_frame(gl.value(), emu.value());
                     for (const auto& v : emu.value().stats.views) pruned += v.items_before - v.items_after;
                 }
             }
@@ -110,7 +95,7 @@ TEST_CASE("whole CULLIDE frames at 1024^2: OSMesa and the emulator agree pass fo
         o.device = device.value().get();
         auto gl = cullide::process_frame(objects, o);
         REQUIRE(gl.ok());
-        check_same(gl.value(), emu.value());
+        check_same_frame(gl.value(), emu.value());
         queries += emu.value().stats.queries;
     }
     MESSAGE("queries compared: " << queries);

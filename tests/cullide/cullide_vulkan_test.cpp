@@ -10,24 +10,9 @@
 #include "cullide/pipeline.h"
 #include "cullide/scenes.h"
 #include "vulkan_query_device.h"
+#include "same_frame.h"
 
-namespace {
-
-void check_same(const cullide::FrameResult& vk, const cullide::FrameResult& emu) {
-    CHECK(vk.pairs == emu.pairs);
-    CHECK(vk.stats.queries == emu.stats.queries);
-    CHECK(vk.stats.triangles_rasterized == emu.stats.triangles_rasterized);
-    CHECK(vk.stats.pcs_boxes == emu.stats.pcs_boxes);
-    CHECK(vk.stats.pcs_objects == emu.stats.pcs_objects);
-    CHECK(vk.stats.pcs_subobjects == emu.stats.pcs_subobjects);
-    REQUIRE(vk.stats.views.size() == emu.stats.views.size());
-    for (std::size_t v = 0; v < vk.stats.views.size(); ++v) {
-        CAPTURE(v);
-        CHECK(vk.stats.views[v].items_after == emu.stats.views[v].items_after);
-    }
-}
-
-}  // namespace
+using cullide_test::check_same_frame;
 
 TEST_CASE("cullide and qcullide-gl prune the same on lavapipe as on the emulator's Vulkan rules, every scene") {
     auto device = cullide_oracle::make_vulkan_query_device();
@@ -63,7 +48,7 @@ TEST_CASE("cullide and qcullide-gl prune the same on lavapipe as on the emulator
                         o.device = device.value().get();
                         auto vk = cullide::process_frame(objects, o);
                         REQUIRE_MESSAGE(vk.ok(), (vk.ok() ? "" : vk.error().message));
-                        check_same(vk.value(), emu.value());
+                        check_same_frame(vk.value(), emu.value());
                         for (const auto& v : emu.value().stats.views) pruned += v.items_before - v.items_after;
                     }
                 }
