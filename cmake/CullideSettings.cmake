@@ -49,6 +49,9 @@ if(CULLIDE_BUILD_FUZZERS)
   endif()
   if(CULLIDE_FUZZ_SANITIZE STREQUAL "")
     add_compile_options(-fsanitize=fuzzer-no-link -fno-omit-frame-pointer)
+    # Without a sanitizer runtime nothing else defines the coverage callbacks for the programs that
+    # are not fuzz targets (the CLI): link libFuzzer's runtime without its main into every program.
+    add_link_options(-fsanitize=fuzzer-no-link)
   else()
     add_compile_options(-fsanitize=fuzzer-no-link,${CULLIDE_FUZZ_SANITIZE} -fno-omit-frame-pointer)
     add_link_options(-fsanitize=${CULLIDE_FUZZ_SANITIZE})

@@ -53,7 +53,7 @@ ledger_table() {
       return s neg
     }
     END {
-      print "| target | executions | seconds (wall, all jobs) | runs | findings | last coverage (cov) | last run |"
+      print "| target | executions | wall seconds | runs | findings | last coverage (cov) | last run |"
       print "|---|---:|---:|---:|---:|---:|---|"
       for (i = 1; i <= n; ++i) {
         t = order[i]
