@@ -32,15 +32,30 @@ if(CULLIDE_SANITIZE)
   add_link_options(-fsanitize=${CULLIDE_SANITIZE})
 endif()
 
-# Fuzzing: every target in the tree (the libraries above all) gets coverage instrumentation and
-# ASan + UBSan, or libFuzzer would only see the fuzz target's own file. Fuzz targets add the
-# libFuzzer main themselves (fuzz/CMakeLists.txt).
+# Fuzzing: every target in the tree (the libraries above all) gets coverage instrumentation and,
+# by default, ASan + UBSan, or libFuzzer would only see the fuzz target's own file. Fuzz targets add
+# the libFuzzer main themselves (fuzz/CMakeLists.txt). CULLIDE_FUZZ_SANITIZE picks the sanitizers:
+# "address,undefined" (default, CI), "undefined" or "" (coverage only: every target checks its own
+# property against a reference, so a campaign build without ASan still finds wrong answers, several
+# times faster; scripts/fuzz.sh campaign --fast).
+set(CULLIDE_FUZZ_SANITIZE "address,undefined" CACHE STRING
+    "Sanitizers of the fuzz build (comma list; empty = coverage instrumentation only)")
 if(CULLIDE_BUILD_FUZZERS)
   if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")
     message(FATAL_ERROR "CULLIDE_BUILD_FUZZERS needs clang (configure with -DCMAKE_CXX_COMPILER=clang++)")
   endif()
-  add_compile_options(-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer)
-  add_link_options(-fsanitize=address,undefined)
+  if(CULLIDE_FUZZ_SANITIZE MATCHES "[^a-z,]")
+    message(FATAL_ERROR "CULLIDE_FUZZ_SANITIZE must be a comma list of sanitizer names, got '${CULLIDE_FUZZ_SANITIZE}'")
+  endif()
+  if(CULLIDE_FUZZ_SANITIZE STREQUAL "")
+    add_compile_options(-fsanitize=fuzzer-no-link -fno-omit-frame-pointer)
+    # Without a sanitizer runtime nothing else defines the coverage callbacks for the programs that
+    # are not fuzz targets (the CLI): link libFuzzer's runtime without its main into every program.
+    add_link_options(-fsanitize=fuzzer-no-link)
+  else()
+    add_compile_options(-fsanitize=fuzzer-no-link,${CULLIDE_FUZZ_SANITIZE} -fno-omit-frame-pointer)
+    add_link_options(-fsanitize=${CULLIDE_FUZZ_SANITIZE})
+  endif()
 endif()
 
 # One call for every project target. Build-only: an installed static library must not pass our
