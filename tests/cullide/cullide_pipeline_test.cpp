@@ -427,9 +427,11 @@ cullide::Mesh sphere(cullide::Vec3 c, double r, int rings, int segments, std::st
 // tasks of the exact stage, the case where auto runs R-CULLIDE's views.
 std::vector<cullide::Mesh> sphere_heap() {
     std::vector<cullide::Mesh> heap;
-    for (int k = 0; k < 20; ++k)
-        heap.push_back(sphere({0.13 * (k % 3), 0.11 * (k % 4), 0.07 * k}, 1.0 + 0.031 * k, 16, 24,
-                              "s" + std::to_string(k)));
+    for (int k = 0; k < 20; ++k) {
+        std::string name = "s";
+        name.append(std::to_string(k));  // not "s" + std::string&&: GCC 12's false -Wrestrict at -O3 (bug 105329)
+        heap.push_back(sphere({0.13 * (k % 3), 0.11 * (k % 4), 0.07 * k}, 1.0 + 0.031 * k, 16, 24, name));
+    }
     return heap;
 }
 
