@@ -629,9 +629,9 @@ void gather(const TriTask& t, const ExactObject& o, const TriangleBoxes& boxes, 
             r.hi[k] = fb.hi[k];
         }
         r.pos = p;
-        const std::uint32_t v0 = t.gv.cell(r.lo[v]);
-        r.low = t.gu.cell(r.lo[u]) | v0 << 16;
-        const std::uint16_t s1 = t.row_slab[t.gv.cell(r.hi[v])];
+        const std::uint32_t v0 = t.gv.cell(static_cast<double>(r.lo[v]));
+        r.low = t.gu.cell(static_cast<double>(r.lo[u])) | v0 << 16;
+        const std::uint16_t s1 = t.row_slab[t.gv.cell(static_cast<double>(r.hi[v]))];
         for (std::uint16_t s = t.row_slab[v0]; s <= s1; ++s) out[s].push_back(r);
     }
 }
@@ -656,7 +656,8 @@ void sweep_slab(const TriTask& t, int s, const std::vector<TriRef>& refs, std::s
     for (std::size_t i = 0; i < refs.size(); ++i) {
         const TriRef& r = refs[i];
         Span& sp = spans[i];
-        sp = {r.low & 0xffffu, t.gu.cell(r.hi[u]), std::max(r.low >> 16, r0), std::min(t.gv.cell(r.hi[v]), r1 - 1)};
+        sp = {r.low & 0xffffu, t.gu.cell(static_cast<double>(r.hi[u])), std::max(r.low >> 16, r0),
+              std::min(t.gv.cell(static_cast<double>(r.hi[v])), r1 - 1)};
         const std::size_t side = i < n0 ? 0 : 1;
         for (std::uint32_t cv = sp.v0; cv <= sp.v1; ++cv)
             for (std::uint32_t cu = sp.u0; cu <= sp.u1; ++cu) ++next[2 * ((cv - r0) * gu + cu) + side + 1];

@@ -79,7 +79,7 @@ struct FloatBox {
 // outer side, +-the largest float on the inner one). Branch-free: half of all conversions round the
 // wrong way, so branches on it are mispredicted half the time.
 [[nodiscard]] inline float float_down(double x) {
-    constexpr double kMax = std::numeric_limits<float>::max();
+    constexpr double kMax = static_cast<double>(std::numeric_limits<float>::max());
     const auto f = static_cast<float>(std::clamp(x, -kMax, kMax));
     // Floats as sign-magnitude integers, mapped to two's complement to step one float down.
     auto ordered = std::bit_cast<std::int32_t>(f);
