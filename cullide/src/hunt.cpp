@@ -17,28 +17,25 @@
 #include "cullide/predicates.h"
 #include "cullide/tri_tri.h"
 #include "cullide/visibility.h"
+#include "scene_math.h"
 
 namespace cullide::hunt {
 namespace {
 
+// The scenes' SplitMix64 (scene_math.h) with the draws the generators use.
 class Rng {
  public:
-    explicit Rng(std::uint64_t seed) : s_(seed) {}
-    std::uint64_t next() {
-        std::uint64_t z = (s_ += 0x9E3779B97F4A7C15ULL);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-        return z ^ (z >> 31);
-    }
-    double unit() { return static_cast<double>(next() >> 11) * 0x1p-53; }  // [0, 1)
-    double range(double lo, double hi) { return lo + (hi - lo) * unit(); }
-    int below(int n) { return static_cast<int>(next() % static_cast<std::uint64_t>(n)); }
+    explicit Rng(std::uint64_t seed) : g_(seed) {}
+    std::uint64_t next() { return g_.next(); }
+    double unit() { return g_.uniform01(); }  // [0, 1)
+    double range(double lo, double hi) { return g_.uniform(lo, hi); }
+    int below(int n) { return static_cast<int>(g_.below(static_cast<std::uint64_t>(n))); }
     int between(int lo, int hi) { return lo + below(hi - lo + 1); }  // both included
     bool coin(int percent = 50) { return below(100) < percent; }
     Vec3 point(double lo, double hi) { return {range(lo, hi), range(lo, hi), range(lo, hi)}; }
 
  private:
-    std::uint64_t s_;
+    det::SplitMix64 g_;
 };
 
 // A seed's stream for one purpose, independent of the others drawn from the same seed.

@@ -70,24 +70,26 @@ std::uint64_t triangles(const Frame& f) {
 
 // The planted miss: a wall in the plane x = 0 (two triangles, seen edge-on in the y and z views,
 // where it covers no pixel and is pruned as fully visible), crossed by a box, plus a distant box.
+// An axis-aligned box: 8 shared vertices, 12 triangles facing out.
+Mesh box(std::string name, Vec3 lo, Vec3 hi) {
+    Mesh m;
+    m.name = std::move(name);
+    for (int i = 0; i < 8; ++i)
+        m.positions.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
+    const std::uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                   {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (const auto& f : q) {
+        m.triangles.push_back({f[0], f[1], f[2]});
+        m.triangles.push_back({f[0], f[2], f[3]});
+    }
+    return m;
+}
+
 Frame planted_wall() {
     Mesh wall;
     wall.name = "wall";
     wall.positions = {{0, -1, -1}, {0, 1, -1}, {0, 1, 1}, {0, -1, 1}};
     wall.triangles = {{0, 1, 2}, {0, 2, 3}};
-    auto box = [](std::string name, Vec3 lo, Vec3 hi) {
-        Mesh m;
-        m.name = std::move(name);
-        for (int i = 0; i < 8; ++i)
-            m.positions.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
-        const std::uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                                       {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-        for (const auto& f : q) {
-            m.triangles.push_back({f[0], f[1], f[2]});
-            m.triangles.push_back({f[0], f[2], f[3]});
-        }
-        return m;
-    };
     return {wall, box("crosser", {-0.25, 0.1, 0.2}, {0.3, 0.45, 0.6}),
             box("far", {2, 2, 2}, {2.5, 2.5, 2.5})};
 }
@@ -181,20 +183,7 @@ TEST_CASE("the planted edge-on miss is shrunk to a smaller frame that still miss
 }
 
 TEST_CASE("boxes touching face to face are missed at any setting, and classified touching") {
-    const auto box = [](Vec3 lo, Vec3 hi) {
-        Mesh m;
-        m.name = "box";
-        for (int i = 0; i < 8; ++i)
-            m.positions.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
-        const std::uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                                       {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-        for (const auto& f : q) {
-            m.triangles.push_back({f[0], f[1], f[2]});
-            m.triangles.push_back({f[0], f[2], f[3]});
-        }
-        return m;
-    };
-    const Frame touching{box({0, 0, 0}, {1, 1, 1}), box({1, 0.25, 0.25}, {2, 0.75, 0.75})};
+    const Frame touching{box("box", {0, 0, 0}, {1, 1, 1}), box("box", {1, 0.25, 0.25}, {2, 0.75, 0.75})};
     cullide::FrameContext context;
     const RunOptions opt = gl_exact_cullide();
     const hunt::Verdict v = hunt::check(touching, opt, context).value();
