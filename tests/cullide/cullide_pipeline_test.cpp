@@ -332,6 +332,67 @@ TEST_CASE("every method refuses coordinates outside the exact range, as the grou
     }
 }
 
+TEST_CASE("exact and auto, checked in exact_pairs' scan, name the first problem the serial checks name") {
+    // process_frame leaves the scene checks of a frame that goes straight to exact_pairs over every
+    // object to exact_pairs' parallel scan: the message must be the one validate_scene, then
+    // validate_exact_range, give, naming the first problem in that order.
+    const auto scene = [] {
+        std::vector<cullide::Mesh> objects;
+        for (int o = 0; o < 4; ++o) objects.push_back(cube({0.4 * o, 0, 0}, 1.0, std::string("c").append(std::to_string(o))));
+        return objects;
+    };
+    struct Case {
+        const char* what;
+        std::vector<cullide::Mesh> objects;
+        const char* must_name;
+    };
+    std::vector<Case> cases;
+    {
+        auto s = scene();  // a range problem in object 1, an index problem in object 2: the index first
+        s[1].positions[3].y = 0x1p-310;
+        s[2].triangles[5][2] = 8;
+        cases.push_back({"index after range", std::move(s), "object 2: mesh 'c2': triangle 5 vertex index 8"});
+    }
+    {
+        auto s = scene();  // range problems in objects 1 and 3: object 1's
+        s[3].positions[0].x = 0x1p301;
+        s[1].positions[7].z = -0x1p-1070;
+        cases.push_back({"two range problems", std::move(s), "object 1: mesh 'c1': vertex 7 coordinate z"});
+    }
+    {
+        auto s = scene();  // a NaN in object 3, an empty object 2
+        s[3].positions[2].x = std::nan("");
+        s[2].triangles.clear();
+        cases.push_back({"empty before non-finite", std::move(s), "object 2: mesh 'c2': has no triangles"});
+    }
+    {
+        auto s = scene();
+        s[0].positions[6].y = INFINITY;
+        cases.push_back({"infinite", std::move(s), "object 0: mesh 'c0': vertex 6 has a non-finite coordinate"});
+    }
+    for (const Case& c : cases) {
+        CAPTURE(c.what);
+        cullide::Status serial = cullide::validate_scene(c.objects);
+        if (serial) serial = cullide::validate_exact_range(c.objects);
+        REQUIRE_FALSE(serial.ok());
+        CHECK(serial.error().message.find(c.must_name) != std::string::npos);
+        for (Method m : {Method::Exact, Method::Auto})
+            for (bool self : {false, true})
+                for (int threads : {1, 2}) {
+                    CAPTURE(cullide::to_string(m));
+                    CAPTURE(self);
+                    CAPTURE(threads);
+                    cullide::RunOptions o;
+                    o.method = m;
+                    o.self = self;
+                    o.threads = threads;
+                    auto r = cullide::process_frame(c.objects, o);
+                    REQUIRE_FALSE(r.ok());
+                    CHECK(r.error().message == serial.error().message);
+                }
+    }
+}
+
 TEST_CASE("a view 2^-195 thin along one axis does not overflow the offset solids") {
     // Regression of a pipeline_fuzz finding: two objects whose bounds span 2^-195 along y gave a
     // view scale near 2^195, and rcullide-offset failed with "its box overflows float in clip
