@@ -23,6 +23,10 @@
 #include <utility>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "cullide/ground_truth.h"
 #include "cullide/mesh.h"
 
@@ -95,6 +99,51 @@ struct FloatBox {
         f.lo[k] = float_down(b.lo[k]);
         f.hi[k] = float_up(b.hi[k]);
     }
+    return f;
+}
+
+// float_box of the box [lo, hi], every bound as float_down / float_up give it (the same bits; x86-64:
+// four bounds per SSE2 step, the same round-to-nearest conversion and one-step correction). The
+// ground truth's scan rounds every triangle's box, 6 bounds each: scalar, that was a quarter of its
+// time on breaking and leaves.
+[[nodiscard]] inline FloatBox float_box(const Vec3& lo, const Vec3& hi) {
+    FloatBox f;
+#if defined(__SSE2__)
+    // The six float_down arguments lo.x, lo.y, lo.z, -hi.x | -hi.y, -hi.z (float_up(x) = -float_down(-x)).
+    constexpr double kMax = static_cast<double>(std::numeric_limits<float>::max());
+    const __m128d neg = _mm_set1_pd(-0.0);
+    const __m128d x0 = _mm_set_pd(lo.y, lo.x), x1 = _mm_xor_pd(_mm_set_pd(hi.x, lo.z), _mm_set_pd(-0.0, 0.0));
+    const __m128d x2 = _mm_xor_pd(_mm_set_pd(hi.z, hi.y), neg);
+    const auto down4 = [&](__m128d a, __m128d b) {
+        const __m128d ca = _mm_min_pd(_mm_max_pd(a, _mm_set1_pd(-kMax)), _mm_set1_pd(kMax));
+        const __m128d cb = _mm_min_pd(_mm_max_pd(b, _mm_set1_pd(-kMax)), _mm_set1_pd(kMax));
+        const __m128 fa = _mm_cvtpd_ps(ca), fb = _mm_cvtpd_ps(cb);
+        const __m128 both = _mm_movelh_ps(fa, fb);
+        // Lanes whose float lies above its (unclamped) double step one float down.
+        const __m128d above_a = _mm_cmpgt_pd(_mm_cvtps_pd(fa), a), above_b = _mm_cmpgt_pd(_mm_cvtps_pd(fb), b);
+        const __m128i above = _mm_castps_si128(
+            _mm_shuffle_ps(_mm_castpd_ps(above_a), _mm_castpd_ps(above_b), _MM_SHUFFLE(2, 0, 2, 0)));
+        const __m128i magnitude = _mm_set1_epi32(0x7fffffff);
+        __m128i ordered = _mm_castps_si128(both);
+        ordered = _mm_xor_si128(ordered, _mm_and_si128(_mm_srai_epi32(ordered, 31), magnitude));
+        ordered = _mm_add_epi32(ordered, above);  // above: -1 in the lanes that step
+        return _mm_castsi128_ps(_mm_xor_si128(ordered, _mm_and_si128(_mm_srai_epi32(ordered, 31), magnitude)));
+    };
+    alignas(16) float d[8];
+    _mm_store_ps(d, down4(x0, x1));
+    _mm_store_ps(d + 4, down4(x2, x2));
+    f.lo[0] = d[0];
+    f.lo[1] = d[1];
+    f.lo[2] = d[2];
+    f.hi[0] = -d[3];
+    f.hi[1] = -d[4];
+    f.hi[2] = -d[5];
+#else
+    for (int k = 0; k < 3; ++k) {
+        f.lo[k] = float_down(lo[k]);
+        f.hi[k] = float_up(hi[k]);
+    }
+#endif
     return f;
 }
 

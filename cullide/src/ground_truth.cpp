@@ -168,13 +168,7 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
                     block.lo = {std::min(block.lo.x, lo.x), std::min(block.lo.y, lo.y), std::min(block.lo.z, lo.z)};
                     block.hi = {std::max(block.hi.x, hi.x), std::max(block.hi.y, hi.y), std::max(block.hi.z, hi.z)};
                     std::construct_at(box_out + t, Aabb{lo, hi});
-                    detail::FloatBox* fb = std::construct_at(float_out + t);
-                    fb->lo[0] = detail::float_down(lo.x);
-                    fb->lo[1] = detail::float_down(lo.y);
-                    fb->lo[2] = detail::float_down(lo.z);
-                    fb->hi[0] = detail::float_up(hi.x);
-                    fb->hi[1] = detail::float_up(hi.y);
-                    fb->hi[2] = detail::float_up(hi.z);
+                    std::construct_at(float_out + t, detail::float_box(lo, hi));
                 }
                 std::construct_at(block_out + b0 / detail::kBoxBlock, block);
                 for (int k = 0; k < 3; ++k) {
