@@ -540,7 +540,7 @@ void plan_task(TriTask& t, std::span<const ExactObject> objects, std::span<const
 
 // Gathers the triangles of one side of a task in positions [first, last) meeting its common box
 // (self: all), into the slabs their rows touch; flags them in `in_task` (pair tasks).
-// An object's triangles in a spatial order (Morton order of their box centres, 10 bits an axis over
+// An object's triangles in a spatial order (Morton order of their box centres, 4 bits an axis over
 // the object's box) with the box of each block of kBoxBlock of them. For an object in several pair
 // tasks, where the mesh's own order leaves blocks loose: the big object of leaves (about 40 K
 // triangles in 57 tasks, 1,764 of them in any common box) had every task read all its triangles.
@@ -559,47 +559,62 @@ std::uint32_t spread_bits(std::uint32_t x) {
     return x;
 }
 
-SpatialOrder spatial_order(const ExactObject& o) {
+// One counting sort on a 12-bit Morton code (4 bits an axis: 4,096 cells over the object's box),
+// stable, so a cell keeps the mesh's order; made in jobs of kOrderChunk triangles (histogram per
+// job, scan in (cell, job) order, scatter per job), so the order is the same for any thread count.
+// The full 30-bit code in three radix passes, on one thread, was a third of a leaves frame.
+constexpr std::size_t kOrderChunk = 8192;
+constexpr std::uint32_t kOrderCells = 1u << 12;
+
+SpatialOrder spatial_order(const ExactObject& o, int threads) {
     const std::span<const Aabb> boxes = o.triangle_boxes;
     const std::size_t n = boxes.size();
     std::array<double, 3> scale{};
     for (int k = 0; k < 3; ++k) {
         const double extent = o.box.hi[k] - o.box.lo[k];
-        scale[static_cast<std::size_t>(k)] = extent > 0.0 ? 1023.0 / extent : 0.0;
+        scale[static_cast<std::size_t>(k)] = extent > 0.0 ? 15.0 / extent : 0.0;
     }
-    std::vector<std::uint64_t> a(n), b(n);
-    for (std::size_t p = 0; p < n; ++p) {
-        std::uint32_t code = 0;
-        for (int k = 0; k < 3; ++k) {
-            const double c = 0.5 * boxes[p].lo[k] + 0.5 * boxes[p].hi[k];
-            const double q = std::clamp((c - o.box.lo[k]) * scale[static_cast<std::size_t>(k)], 0.0, 1023.0);
-            code |= spread_bits(static_cast<std::uint32_t>(q)) << k;
+    const std::size_t jobs = (n + kOrderChunk - 1) / kOrderChunk;
+    std::vector<std::uint16_t> code(n);
+    std::vector<std::uint32_t> start(jobs * kOrderCells, 0);  // counts, then cursors, of (job, cell)
+    parallel_chunks(threads, jobs, [&](std::size_t j) {
+        std::uint32_t* count = start.data() + j * kOrderCells;
+        const std::size_t end = std::min(n, (j + 1) * kOrderChunk);
+        for (std::size_t p = j * kOrderChunk; p < end; ++p) {
+            std::uint32_t c = 0;
+            for (int k = 0; k < 3; ++k) {
+                const double centre = 0.5 * boxes[p].lo[k] + 0.5 * boxes[p].hi[k];
+                const double q = std::clamp((centre - o.box.lo[k]) * scale[static_cast<std::size_t>(k)], 0.0, 15.0);
+                c |= spread_bits(static_cast<std::uint32_t>(q)) << k;
+            }
+            code[p] = static_cast<std::uint16_t>(c);
+            ++count[c];
         }
-        a[p] = std::uint64_t{code} << 32 | p;
-    }
-    // Stable LSD radix sort on the 30 code bits, 10 a pass.
-    std::array<std::uint32_t, 1024> count{};
-    for (const unsigned shift : {32u, 42u, 52u}) {
-        count.fill(0);
-        for (const std::uint64_t x : a) ++count[(x >> shift) & 0x3ffu];
-        std::uint32_t sum = 0;
-        for (std::uint32_t& c : count) sum += std::exchange(c, sum);
-        for (const std::uint64_t x : a) b[count[(x >> shift) & 0x3ffu]++] = x;
-        a.swap(b);
-    }
+    });
+    std::uint32_t sum = 0;
+    for (std::uint32_t c = 0; c < kOrderCells; ++c)
+        for (std::size_t j = 0; j < jobs; ++j) sum += std::exchange(start[j * kOrderCells + c], sum);
     SpatialOrder s;
     s.positions.resize(n);
-    for (std::size_t q = 0; q < n; ++q) s.positions[q] = static_cast<std::uint32_t>(a[q]);
+    parallel_chunks(threads, jobs, [&](std::size_t j) {
+        std::uint32_t* cursor = start.data() + j * kOrderCells;
+        const std::size_t end = std::min(n, (j + 1) * kOrderChunk);
+        for (std::size_t p = j * kOrderChunk; p < end; ++p) s.positions[cursor[code[p]]++] = static_cast<std::uint32_t>(p);
+    });
     s.blocks.resize((n + kBoxBlock - 1) / kBoxBlock);
-    for (std::size_t q = 0; q < n; ++q) {
-        const Aabb& t = boxes[s.positions[q]];
-        Aabb& block = s.blocks[q / kBoxBlock];
-        if (q % kBoxBlock == 0) block = t;
-        for (int k = 0; k < 3; ++k) {
-            block.lo[k] = std::min(block.lo[k], t.lo[k]);
-            block.hi[k] = std::max(block.hi[k], t.hi[k]);
+    constexpr std::size_t kBlocksPerJob = kOrderChunk / kBoxBlock;
+    parallel_chunks(threads, (s.blocks.size() + kBlocksPerJob - 1) / kBlocksPerJob, [&](std::size_t j) {
+        const std::size_t end = std::min(n, (j + 1) * kOrderChunk);
+        for (std::size_t q = j * kOrderChunk; q < end; ++q) {
+            const Aabb& t = boxes[s.positions[q]];
+            Aabb& block = s.blocks[q / kBoxBlock];
+            if (q % kBoxBlock == 0) block = t;
+            for (int k = 0; k < 3; ++k) {
+                block.lo[k] = std::min(block.lo[k], t.lo[k]);
+                block.hi[k] = std::max(block.hi[k], t.hi[k]);
+            }
         }
-    }
+    });
     return s;
 }
 
@@ -895,9 +910,7 @@ ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
     for (std::uint32_t o = 0; o < n; ++o)
         if (pair_tasks[o] >= kSpatialTasks && objects[o].triangle_boxes.size() >= kSpatialMin) to_order.push_back(o);
     std::vector<SpatialOrder> orders(n);
-    parallel_chunks(options.threads, to_order.size(), [&](std::size_t i) {
-        orders[to_order[i]] = spatial_order(objects[to_order[i]]);
-    });
+    for (const std::uint32_t o : to_order) orders[o] = spatial_order(objects[o], options.threads);  // parallel inside
     std::vector<std::vector<unsigned char>> in_task(n);
     for (std::uint32_t o = 0; o < n; ++o) in_task[o].assign(objects[o].triangle_boxes.size(), 0);
     std::vector<SlabRefs> gathered(jobs.size());
