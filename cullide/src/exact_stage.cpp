@@ -137,10 +137,12 @@ struct Task {
 struct GridAxis {
     int axis = 0, cells = 1;
     double lo = 0.0, scale = 0.0;
+    // Clamped first, then truncated: the same cell as floor then clamp (truncation is floor on
+    // [0, cells - 1]), without std::floor, which x86-64 without SSE4.1 has no instruction for (5% of
+    // a breaking frame, three cells per gathered triangle).
     [[nodiscard]] std::uint32_t cell(double x) const {
         if (cells == 1) return 0;
-        const double c = std::floor((x - lo) * scale);
-        return static_cast<std::uint32_t>(std::clamp(c, 0.0, static_cast<double>(cells - 1)));
+        return static_cast<std::uint32_t>(std::clamp((x - lo) * scale, 0.0, static_cast<double>(cells - 1)));
     }
 };
 
