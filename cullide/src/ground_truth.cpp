@@ -140,9 +140,14 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
             const ScanJob& job = jobs[j];
             const Mesh& m = objects[job.object];
             if (job.positions) {
-                for (std::size_t v = job.first; v < job.last; ++v)
-                    for (int k = 0; k < 3; ++k)
-                        if (!predicate_coordinate_ok(m.positions[v][k])) job_ok[j] = 0;
+                // Branch-free into a local flag: a store to job_ok (bytes, which may alias anything)
+                // in the loop made the compiler reload the mesh on every coordinate.
+                bool bad = false;
+                for (std::size_t v = job.first; v < job.last; ++v) {
+                    const Vec3 p = m.positions[v];
+                    bad |= !predicate_coordinate_ok(p.x) | !predicate_coordinate_ok(p.y) | !predicate_coordinate_ok(p.z);
+                }
+                if (bad) job_ok[j] = 0;
                 return;
             }
             const std::size_t count = m.positions.size();
