@@ -61,7 +61,9 @@ inline constexpr double kAutoViewsPay = 8.0;
 inline constexpr std::uint64_t kAutoMinViewTriangles = 4096;
 
 // The plan Method::Auto follows for `objects` restricted to `active` (strictly increasing indices
-// into `objects`; the broad phase's survivors). Meshes must be valid (validate_scene).
+// into `objects`; the broad phase's survivors). It reads positions and triangle counts only, never
+// an index, so it is safe on meshes not yet checked (process_frame plans an `auto` frame before
+// exact_pairs checks the scene; an invalid scene's plan is meaningless, and the frame fails).
 [[nodiscard]] AutoPlan plan_auto(std::span<const Mesh> objects, std::span<const std::uint32_t> active);
 
 // The optional first stage, on the objects' axis-aligned boxes (spatialhash/broad_phase.h).
