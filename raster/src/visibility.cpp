@@ -3,6 +3,7 @@
 #include "raster/visibility.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -58,6 +59,14 @@ struct Ref {
     std::uint32_t tri;
 };
 
+// A triangle's encoded depth bounds: lo <= every zmin and hi >= every zmax of its pixels.
+struct ZBound {
+    std::uint32_t lo, hi;
+};
+
+// Block side inside a tile: the unit that the triangles' depth bounds settle at once.
+constexpr int kBlock = 16;
+
 bool valid_vertex(const Double4& d) {
     return d.w == 1.0 && std::fabs(d.x) <= kMaxExactBoundsCoordinate && std::fabs(d.y) <= kMaxExactBoundsCoordinate &&
            std::fabs(d.z) <= kMaxExactBoundsCoordinate;  // false for NaN too
@@ -95,23 +104,30 @@ struct TileGrid {
 
 }  // namespace
 
-// run()'s phases, in order: front_end, bin, then shade per tile; buffers kept between calls.
+// run()'s phases, in order: front_end, depth_bounds, bin, then shade per tile; buffers kept between
+// calls.
 struct VisibilityPass::State {
     std::vector<std::vector<detail::BoundsTri>> tris;     // per item
     std::vector<std::vector<detail::BoundsVertex>> pool;  // per item
+    std::vector<std::vector<ZBound>> zq;                  // per item, per triangle: encoded depth bounds
     std::vector<std::uint8_t> bad;                        // per item: an input check failed
+    std::vector<std::uint8_t> hit;                        // per item: found not fully visible (atomic_ref)
     std::vector<std::vector<Ref>> bins;                   // per tile
     std::vector<std::vector<Fragment>> frags;             // per tile (scratch)
-    std::vector<std::vector<std::uint32_t>> hits;         // per tile: items found not fully visible
+    std::vector<std::vector<Ref>> block_refs;             // per tile (scratch): one block's triangles
+    std::vector<std::vector<std::uint8_t>> block_need;    // per tile (scratch): ... whose queries can pass
     std::vector<std::uint32_t> min1, obj1, min2;          // per pixel, tile-major (one tile = side^2)
 
     // Front end per item (the recorded draws' own setup, so the same polygons). False when some
     // item failed an input check (bad[i]).
     bool front_end(int width, int height, std::span<const VisibilityItem> items, int threads);
-    // Binning, in item order; with one tile nothing is built (every triangle is in it).
+    // Per triangle, the encoded bounds of every zmin and zmax its pixels can get (zq).
+    void depth_bounds(std::size_t n_items, DepthFormat format);
+    // Binning, in item order (one tile: every triangle, in item order).
     void bin(std::span<const VisibilityItem> items, const TileGrid& grid);
-    // Per tile: every fragment's zmin into the two minima, then every fragment's zmax against the
-    // minimum over the other objects; the items found not fully visible go to hits[tile].
+    // Per block of a tile: settle what the triangles' depth bounds settle; then, only if some item
+    // not yet found may pass there, every fragment's zmin into the two minima and the zmax of the
+    // items that may pass against the minimum over the other objects; such items go to hit[].
     void shade(std::span<const VisibilityItem> items, const TileGrid& grid, int width, int height,
                DepthFormat format, std::size_t tile);
 };
@@ -157,18 +173,37 @@ bool VisibilityPass::State::front_end(int width, int height, std::span<const Vis
     return true;
 }
 
+void VisibilityPass::State::depth_bounds(std::size_t n_items, DepthFormat format) {
+    if (zq.size() < n_items) zq.resize(n_items);
+    for (std::size_t i = 0; i < n_items; ++i) {
+        zq[i].resize(tris[i].size());
+        for (std::size_t k = 0; k < tris[i].size(); ++k) {
+            const detail::BoundsTri& t = tris[i][k];
+            double lo = 0, hi = 0;
+            detail::bounds_depth_range(t, pool[i].data(), lo, hi);
+            // The draw quantizes zlo - margin_z down and zhi + margin_z up; subtraction, addition
+            // and both quantizations are monotone, so these bound every pixel's values.
+            zq[i][k] = {detail::quantize_down(lo - t.margin_z, format), detail::quantize_up(hi + t.margin_z, format)};
+        }
+    }
+}
+
 void VisibilityPass::State::bin(std::span<const VisibilityItem> items, const TileGrid& grid) {
     const std::size_t tile_count = grid.count();
     if (bins.size() < tile_count) {
         bins.resize(tile_count);
         frags.resize(tile_count);
-        hits.resize(tile_count);
+        block_refs.resize(tile_count);
+        block_need.resize(tile_count);
     }
     for (std::size_t t = 0; t < tile_count; ++t) bins[t].clear();
-    if (tile_count == 1) return;
     for (std::size_t i = 0; i < items.size(); ++i) {
         for (std::size_t k = 0; k < tris[i].size(); ++k) {
             const detail::BoundsTri& t = tris[i][k];
+            if (tile_count == 1) {
+                bins[0].push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)});
+                continue;
+            }
             for (int ty = t.y0 / grid.side; ty <= t.y1 / grid.side; ++ty)
                 for (int tx = t.x0 / grid.side; tx <= t.x1 / grid.side; ++tx)
                     bins[static_cast<std::size_t>(ty) * static_cast<std::size_t>(grid.x) + static_cast<std::size_t>(tx)]
@@ -177,15 +212,24 @@ void VisibilityPass::State::bin(std::span<const VisibilityItem> items, const Til
     }
 }
 
+// Blocks: an item's query can pass at a pixel only if one of its fragments there has zmax >= the
+// minimum zmin over the other objects' fragments there (and the clear value). Every fragment in a
+// block comes from a triangle whose pixel box meets the block, and its zmin >= the triangle's zq.lo,
+// its zmax <= zq.hi. So with L = the minimum of zq.lo over the block's triangles of the other
+// objects (the clear value if none), a triangle with zq.hi < L has no fragment in the block whose
+// query passes: its fragments need no test. A block where no triangle of an item not yet found is
+// left needs no per-pixel work at all. The zmin of every triangle in a tested block still enters
+// its minima, so each tested fragment meets exactly the value the whole-tile pass gave it; and an
+// item's answer is the OR over blocks, so skipping the items already found changes nothing. The
+// answer is therefore the whole-tile pass's, bit for bit, whatever the thread timing (the skip of
+// found items reads flags another task may be setting: it only changes how much work is done).
 void VisibilityPass::State::shade(std::span<const VisibilityItem> items, const TileGrid& grid, int width,
                                   int height, DepthFormat format, std::size_t tile) {
-    const bool one_tile = grid.count() == 1;  // then every triangle is in it: no bin was built
     auto& tile_bin = bins[tile];
+    if (tile_bin.empty()) return;
     auto& tile_frags = frags[tile];
-    auto& tile_hits = hits[tile];
-    tile_frags.clear();
-    tile_hits.clear();
-    if (tile_bin.empty() && !one_tile) return;
+    auto& blk = block_refs[tile];
+    auto& need = block_need[tile];
     const int side = grid.side;
     const int tx = static_cast<int>(tile % static_cast<std::size_t>(grid.x));
     const int ty = static_cast<int>(tile / static_cast<std::size_t>(grid.x));
@@ -196,55 +240,98 @@ void VisibilityPass::State::shade(std::span<const VisibilityItem> items, const T
     std::uint32_t* tile_min1 = min1.data() + tile * tile_pixels;
     std::uint32_t* tile_obj1 = obj1.data() + tile * tile_pixels;
     std::uint32_t* tile_min2 = min2.data() + tile * tile_pixels;
-    std::fill(tile_min1, tile_min1 + tile_pixels, clear);
-    std::fill(tile_obj1, tile_obj1 + tile_pixels, kNoObject);
-    std::fill(tile_min2, tile_min2 + tile_pixels, clear);
-    const auto draw = [&](const Ref r) __attribute__((always_inline)) {
-        const detail::BoundsTri& t = tris[r.item][r.tri];
-        const std::uint32_t obj = items[r.item].object;
-        const double mz = t.margin_z;
-        double last_lo = std::numeric_limits<double>::quiet_NaN(), last_hi = last_lo;
-        std::uint32_t zmin = 0, zmax = 0;  // quantized once per distinct depth
-        const detail::PixelRect rect{std::max(x0, t.x0), std::max(y0, t.y0), std::min(x1, t.x1), std::min(y1, t.y1)};
-        detail::bounds_pixels(t, pool[r.item].data(), rect, [&](int px, int py, double zlo, double zhi) {
-            const auto p = static_cast<std::uint32_t>((py - y0) * side + (px - x0));
-            if (!(zlo == last_lo)) {
-                last_lo = zlo;
-                zmin = detail::quantize_down(zlo - mz, format);
-            }
-            if (!(zhi == last_hi)) {
-                last_hi = zhi;
-                zmax = detail::quantize_up(zhi + mz, format);
-            }
-            if (obj == tile_obj1[p]) {
-                tile_min1[p] = std::min(tile_min1[p], zmin);
-            } else if (zmin < tile_min1[p]) {
-                tile_min2[p] = tile_min1[p];
-                tile_min1[p] = zmin;
-                tile_obj1[p] = obj;
-            } else {
-                tile_min2[p] = std::min(tile_min2[p], zmin);
-            }
-            tile_frags.push_back({r.item, p, zmax});
-        });
+    const auto found = [&](std::uint32_t item) {
+        return std::atomic_ref<std::uint8_t>(hit[item]).load(std::memory_order_relaxed) != 0;
     };
-    if (one_tile) {
-        for (std::size_t i = 0; i < items.size(); ++i)
-            for (std::size_t k = 0; k < tris[i].size(); ++k)
-                draw({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)});
-    } else {
-        for (const Ref& r : tile_bin) draw(r);
-    }
-    // min1 is the minimum over all objects (with the clear value) and min2 the minimum over the
-    // objects other than obj1's, so the minimum over the objects other than o is min2 when o is
-    // obj1 and min1 otherwise (ties between objects: then min2 == min1).
-    std::uint32_t last = kNoObject;
-    for (const Fragment& f : tile_frags) {
-        if (f.item == last) continue;
-        const std::uint32_t other = items[f.item].object == tile_obj1[f.pixel] ? tile_min2[f.pixel] : tile_min1[f.pixel];
-        if (f.zmax >= other) {  // the GEQUAL query passes here
-            tile_hits.push_back(f.item);
-            last = f.item;
+    const int block = std::min(side, kBlock);
+    for (int by0 = y0; by0 <= y1; by0 += block) {
+        const int by1 = std::min(by0 + block - 1, y1);
+        for (int bx0 = x0; bx0 <= x1; bx0 += block) {
+            const int bx1 = std::min(bx0 + block - 1, x1);
+            // The block's triangles (in item order) and the two smallest zq.lo over objects, as
+            // the per-pixel minima below keep them.
+            blk.clear();
+            std::uint32_t m1 = clear, o1 = kNoObject, m2 = clear;
+            for (const Ref& r : tile_bin) {
+                const detail::BoundsTri& t = tris[r.item][r.tri];
+                if (t.x1 < bx0 || t.x0 > bx1 || t.y1 < by0 || t.y0 > by1) continue;
+                blk.push_back(r);
+                const std::uint32_t obj = items[r.item].object;
+                const std::uint32_t lo = zq[r.item][r.tri].lo;
+                if (obj == o1) {
+                    m1 = std::min(m1, lo);
+                } else if (lo < m1) {
+                    m2 = m1;
+                    m1 = lo;
+                    o1 = obj;
+                } else {
+                    m2 = std::min(m2, lo);
+                }
+            }
+            need.resize(blk.size());
+            bool any = false;
+            for (std::size_t j = 0; j < blk.size(); ++j) {
+                const Ref r = blk[j];
+                const std::uint32_t other = items[r.item].object == o1 ? m2 : m1;
+                need[j] = !found(r.item) && zq[r.item][r.tri].hi >= other ? 1 : 0;
+                any = any || need[j] != 0;
+            }
+            if (!any) continue;
+
+            for (int py = by0; py <= by1; ++py) {
+                const std::size_t row = static_cast<std::size_t>(py - y0) * static_cast<std::size_t>(side);
+                const std::size_t b = row + static_cast<std::size_t>(bx0 - x0), e = row + static_cast<std::size_t>(bx1 - x0) + 1;
+                std::fill(tile_min1 + b, tile_min1 + e, clear);
+                std::fill(tile_obj1 + b, tile_obj1 + e, kNoObject);
+                std::fill(tile_min2 + b, tile_min2 + e, clear);
+            }
+            tile_frags.clear();
+            for (std::size_t j = 0; j < blk.size(); ++j) {
+                const Ref r = blk[j];
+                const bool keep = need[j] != 0;
+                const detail::BoundsTri& t = tris[r.item][r.tri];
+                const std::uint32_t obj = items[r.item].object;
+                const double mz = t.margin_z;
+                double last_lo = std::numeric_limits<double>::quiet_NaN(), last_hi = last_lo;
+                std::uint32_t zmin = 0, zmax = 0;  // quantized once per distinct depth
+                const detail::PixelRect rect{std::max(bx0, t.x0), std::max(by0, t.y0), std::min(bx1, t.x1),
+                                             std::min(by1, t.y1)};
+                detail::bounds_pixels(t, pool[r.item].data(), rect, [&](int px, int py, double zlo, double zhi) {
+                    const auto p = static_cast<std::uint32_t>((py - y0) * side + (px - x0));
+                    if (!(zlo == last_lo)) {
+                        last_lo = zlo;
+                        zmin = detail::quantize_down(zlo - mz, format);
+                    }
+                    if (obj == tile_obj1[p]) {
+                        tile_min1[p] = std::min(tile_min1[p], zmin);
+                    } else if (zmin < tile_min1[p]) {
+                        tile_min2[p] = tile_min1[p];
+                        tile_min1[p] = zmin;
+                        tile_obj1[p] = obj;
+                    } else {
+                        tile_min2[p] = std::min(tile_min2[p], zmin);
+                    }
+                    if (!keep) return;
+                    if (!(zhi == last_hi)) {
+                        last_hi = zhi;
+                        zmax = detail::quantize_up(zhi + mz, format);
+                    }
+                    tile_frags.push_back({r.item, p, zmax});
+                });
+            }
+            // min1 is the minimum over all objects (with the clear value) and min2 the minimum
+            // over the objects other than obj1's, so the minimum over the objects other than o is
+            // min2 when o is obj1 and min1 otherwise (ties between objects: then min2 == min1).
+            std::uint32_t last = kNoObject;
+            for (const Fragment& f : tile_frags) {
+                if (f.item == last) continue;
+                const std::uint32_t other =
+                    items[f.item].object == tile_obj1[f.pixel] ? tile_min2[f.pixel] : tile_min1[f.pixel];
+                if (f.zmax >= other) {  // the GEQUAL query passes here
+                    std::atomic_ref<std::uint8_t>(hit[f.item]).store(1, std::memory_order_relaxed);
+                    last = f.item;
+                }
+            }
         }
     }
 }
@@ -274,6 +361,7 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
 
     const int side = tile_side(width, height, threads);
     const TileGrid grid{side, (width + side - 1) / side, (height + side - 1) / side};
+    s.depth_bounds(items.size(), format);
     s.bin(items, grid);
     const std::size_t pixels = grid.count() * grid.pixels();
     if (s.min1.size() < pixels) {
@@ -281,12 +369,11 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
         s.obj1.resize(pixels);
         s.min2.resize(pixels);
     }
+    s.hit.assign(items.size(), 0);
     detail::parallel_for(threads, grid.count(),
                          [&](std::size_t tile) { s.shade(items, grid, width, height, format, tile); });
 
-    std::vector<std::uint8_t> result(items.size(), 0);
-    for (std::size_t t = 0; t < grid.count(); ++t)
-        for (const std::uint32_t i : s.hits[t]) result[i] = 1;
+    std::vector<std::uint8_t> result(s.hit.begin(), s.hit.begin() + static_cast<std::ptrdiff_t>(items.size()));
     return result;
 }
 
