@@ -45,6 +45,9 @@ struct BoundsTri {
     // The box (grown by margin_xy, before clamping to the target) is one pixel: that pixel's grown
     // square holds the whole polygon, so its range is the polygon's vertex depth range.
     bool single = false;
+    // Encoded depth bounds of every pixel's zmin (>= zq_lo) and zmax (<= zq_hi), for callers that
+    // fill them in (the fused visibility pass: bounds_depth_range, then the outward quantization).
+    std::uint32_t zq_lo = 0, zq_hi = 0xffffffffu;
     // Which per-pixel path bounds_pixels takes (chosen once by setup_bounds_triangle):
     //  General:  per-row Sutherland-Hodgman clip + per-column edge crossings (any polygon);
     //  Plane:    separating-axis coverage + plane depth, closed form per pixel (a polygon of 3
