@@ -45,6 +45,9 @@ struct BoundsTri {
     // The box (grown by margin_xy, before clamping to the target) is one pixel: that pixel's grown
     // square holds the whole polygon, so its range is the polygon's vertex depth range.
     bool single = false;
+    // Encoded depth bounds of every pixel's zmin (>= zq_lo) and zmax (<= zq_hi), for callers that
+    // fill them in (the fused visibility pass: bounds_depth_range, then the outward quantization).
+    std::uint32_t zq_lo = 0, zq_hi = 0xffffffffu;
     // Which per-pixel path bounds_pixels takes (chosen once by setup_bounds_triangle):
     //  General:  per-row Sutherland-Hodgman clip + per-column edge crossings (any polygon);
     //  Plane:    separating-axis coverage + plane depth, closed form per pixel (a polygon of 3
@@ -464,6 +467,38 @@ inline void general(const BoundsTri& tri, const BoundsVertex* pool, PixelRect re
 }
 
 }  // namespace bounds_paths
+
+// A range [lo, hi] that holds every (zlo, zhi) that bounds_pixels reports for `tri`, over any
+// rectangle: a per-triangle bound that lets a caller settle a depth test for a whole block of
+// pixels without visiting them (the fused visibility pass). Per path:
+//  - single, Column, Row: each value is a vertex depth or an edge crossing clamped to the edge's
+//    depth range (slab_depth_range), so the polygon's vertex depth range holds it exactly;
+//  - Plane: zlo = max(..., pzlo) and zhi = min(..., pzhi), so [pzlo, pzhi];
+//  - General: the row clips (bounds_clip_axis, at most two per row) interpolate new vertices as
+//    a + t * (b - a) with 0 <= t <= 1, which in floating point can leave the edge's depth range by
+//    a few roundings: each clip by at most 5u max|z| (u = 2^-53) plus subnormal absolute errors, so
+//    two by < 2^-49 max|z|. The vertex range is widened by 2^-40 max|z| + 2^-1000, far more.
+// Returned widened values only loosen the bound (a caller may skip less, never wrongly).
+inline void bounds_depth_range(const BoundsTri& tri, const BoundsVertex* pool, double& lo, double& hi) {
+    if (!tri.single && tri.kind == BoundsTri::Kind::Plane) {
+        const BoundsPlane d = load_plane(tri, pool);
+        lo = d.pzlo;
+        hi = d.pzhi;
+        return;
+    }
+    lo = pool[tri.first].z;
+    hi = lo;
+    for (int i = 1; i < tri.n; ++i) {
+        const double z = pool[tri.first + static_cast<std::uint32_t>(i)].z;
+        lo = z < lo ? z : lo;
+        hi = z > hi ? z : hi;
+    }
+    if (!tri.single && tri.kind == BoundsTri::Kind::General) {
+        const double slack = 0x1p-40 * std::max(std::fabs(lo), std::fabs(hi)) + 0x1p-1000;
+        lo -= slack;
+        hi += slack;
+    }
+}
 
 // Calls f(px, py, zlo, zhi) for every pixel of `rect` whose square (grown by
 // tri.margin_xy) meets the polygon (the plane path may add pixels that a rounding-error bound

@@ -29,7 +29,7 @@ Double4 vertex_near(test::Rng& rng, const Double4& c, double r, bool flat) {
     return {c.x + rng.uniform(-r, r), c.y + rng.uniform(-r, r), flat ? c.z : c.z + rng.uniform(-r, r), 1.0};
 }
 
-Scene random_scene(test::Rng& rng, int objects) {
+Scene random_scene(test::Rng& rng, int objects, double scale = 1.0) {
     Scene s;
     s.objects = static_cast<std::uint32_t>(objects);
     // A shared depth for some flat triangles, so that different objects tie exactly.
@@ -43,7 +43,7 @@ Scene random_scene(test::Rng& rng, int objects) {
             for (int t = 0; t < tris; ++t) {
                 const auto base = static_cast<std::uint32_t>(s.vertices.size());
                 const int kind = static_cast<int>(rng.below(6));
-                const double r = kind == 0 ? 0.6 : kind == 1 ? 0.01 : 0.2;  // large, sub-pixel, medium
+                const double r = scale * (kind == 0 ? 0.6 : kind == 1 ? 0.01 : 0.2);  // large, sub-pixel, medium
                 Double4 a = vertex_near(rng, centre, r, false);
                 if (kind == 2) a.z = tie_z;
                 Double4 b = vertex_near(rng, a, r, kind == 2);
@@ -142,6 +142,33 @@ TEST_CASE("The fused visibility pass gives the two recorded passes' answers, any
     // Both answers occur, so the comparison can fail either way.
     CHECK(visible > 20);
     CHECK(hidden > 20);
+}
+
+TEST_CASE("The fused visibility pass with large triangles (tiles settled from depth bounds) gives the recorded answers") {
+    // Triangles a few times larger than above: their boxes average more than kSettleMinArea pixels,
+    // so the pass settles 16-pixel tiles from the triangles' depth bounds and skips items already
+    // found (visibility.cpp), also on a 16 x 16 target that is a single tile.
+    test::Rng rng(20261125);
+    const DepthFormat formats[] = {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F};
+    const int sizes[][2] = {{16, 16}, {37, 23}, {130, 70}};
+    raster::VisibilityPass pass;
+    int visible = 0, hidden = 0;
+    for (int rep = 0; rep < 90; ++rep) {
+        const Scene s = random_scene(rng, 2 + static_cast<int>(rng.below(8)), 2.0 + rng.uniform(0.0, 2.0));
+        const DepthFormat f = formats[rep % 3];
+        const int w = sizes[(rep / 3) % 3][0], h = sizes[(rep / 3) % 3][1];
+        CAPTURE(rep);
+        const std::vector<std::uint8_t> want = recorded(s, w, h, f, 1, true);
+        for (const int threads : {1, 2, 3}) {
+            CAPTURE(threads);
+            auto got = pass.run(w, h, f, items_of(s), threads);
+            REQUIRE_MESSAGE(got.ok(), got.error().message);
+            CHECK(got.value() == want);
+        }
+        for (auto v : want) (v != 0 ? hidden : visible) += 1;
+    }
+    CHECK(visible > 10);
+    CHECK(hidden > 10);
 }
 
 TEST_CASE("The fused visibility pass: an item exactly at another object's depth is not fully visible") {

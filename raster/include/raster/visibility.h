@@ -20,7 +20,11 @@
 //
 // Tiled (64 x 64; 16 or 32 on targets up to 128 or 256 pixels, to keep several tasks) and
 // threaded like raster::execute; every tile is computed by one task in a fixed
-// order and the per-item answers are ORs, so the result does not depend on the thread count.
+// order and the per-item answers are ORs, so the result does not depend on the thread count. Where
+// the triangles are large (boxes of 16 pixels or more on average) the tiles are 16 x 16 and
+// per-triangle depth bounds settle a tile without visiting its pixels where no query can pass
+// there; items already found are not tested again (the same answer, less work:
+// docs/reliable-raster.md, "Tiles settled without per-pixel work").
 #pragma once
 
 #include <cstdint>
