@@ -156,7 +156,13 @@ campaign() {
   [ -f "$ledger" ] || echo "date_utc,commit,target,build,jobs,seconds,executions,exec_per_s,cov,ft,corpus,crashes,timeouts,ooms,load_start,load_end,cores,note" >"$ledger"
   local commit
   commit="$(git rev-parse --short=12 HEAD 2>/dev/null || echo unknown)"
-  if [ -n "$(git status --porcelain --untracked-files=no 2>/dev/null)" ]; then commit="$commit+dirty"; fi
+  # Dirty means changed code: the ledger's own earlier rows (a campaign of several runs writes it)
+  # do not count.
+  local ledger_rel
+  ledger_rel="$(realpath -m --relative-to="$root" "$ledger")"
+  if [ -n "$(git status --porcelain --untracked-files=no -- . ":(exclude)$ledger_rel" 2>/dev/null)" ]; then
+    commit="$commit+dirty"
+  fi
   export LSAN_OPTIONS="suppressions=$root/tests/lsan.supp"
   export ASAN_OPTIONS="${ASAN_OPTIONS:-}${ASAN_OPTIONS:+:}abort_on_error=0"
 
