@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
+#include <cstdlib>
 #include <limits>
 #include <memory>
 #include <string>
@@ -50,6 +51,15 @@ void setup_bounds_draw(const detail::FrontEndParams& p, const Command& c, std::u
                                           pool);
         }
     }
+}
+
+// CULLIDE_RASTER_NO_HIZ set to anything but "" or "0" turns hierarchical Z off (read once).
+bool hiz_allowed_by_environment() {
+    static const bool ok = [] {
+        const char* v = std::getenv("CULLIDE_RASTER_NO_HIZ");
+        return v == nullptr || v[0] == '\0' || (v[0] == '0' && v[1] == '\0');
+    }();
+    return ok;
 }
 
 void finish_results(const CommandBatch& batch, QueryResults& r) {
@@ -270,6 +280,8 @@ struct ShadeContext {
     int width, height;
     DepthFormat format;
     bool allow_simd;
+    bool hiz;                     // hierarchical Z on D16 / D24 targets (pipeline.h, HizTile)
+    detail::HizTile* hiz_tiles;   // per tile, owned by the tile's task
     std::atomic<bool>* answered;  // per query: an any-samples query already has a passing sample
 };
 
@@ -283,6 +295,14 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
     };
     const auto& cmds = ctx.batch.commands();
     const auto& query_kinds = ctx.batch.query_kinds();
+    detail::HizTile* const hiz =
+        ctx.hiz ? &ctx.hiz_tiles[static_cast<std::size_t>(ty) * static_cast<std::size_t>((ctx.width + kTileSize - 1) / kTileSize) +
+                                 static_cast<std::size_t>(tx)]
+                : nullptr;
+    if (hiz != nullptr) {
+        hiz->tile = {x0, y0, x1, y1};
+        hiz->valid = 0;  // bounds are read from the buffer afresh in every batch
+    }
     for (const Ref& r : bin) {
         const std::uint32_t cmd = ctx.draws.cmds[r.draw];
         const Command& c = cmds[cmd];
@@ -293,6 +313,7 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
             const auto& tri = ctx.setup.bounds[r.draw][r.tri];
             passed = detail::bounds_rect(tri, ctx.setup.pool[r.draw].data(), depth_state, ctx.depth,
                                          clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1));
+            if (hiz != nullptr && c.state.depth_write) hiz->valid = 0;  // its writes are not tracked
         } else {
             // Any-samples query with the mask off: once this query has a passing sample (in this
             // tile, or in any tile: the flag), further draws in it change nothing; the kernel also
@@ -302,8 +323,9 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
                              ctx.answered[q].load(std::memory_order_relaxed)))
                 continue;
             const auto& tri = ctx.setup.tris[r.draw][r.tri];
-            passed = detail::raster_rect(tri, depth_state, ctx.depth, clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1),
-                                         ctx.allow_simd, any_only);
+            const detail::PixelRect rect = clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1);
+            passed = hiz != nullptr ? detail::raster_rect_hiz(tri, depth_state, ctx.depth, rect, *hiz, ctx.allow_simd, any_only)
+                             : detail::raster_rect(tri, depth_state, ctx.depth, rect, ctx.allow_simd, any_only);
             if (any_only && passed != 0) ctx.answered[q].store(true, std::memory_order_relaxed);
         }
         if (q == kNoQuery || passed == 0) continue;
@@ -331,6 +353,7 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
         std::vector<std::vector<Ref>> bins;
         std::vector<std::vector<std::pair<std::uint32_t, std::uint64_t>>> tile_counts;
         std::vector<std::atomic<bool>> answered;
+        std::vector<detail::HizTile> hiz_tiles;
     };
     thread_local Scratch scratch;
     Draws& draw_list = scratch.draw_list;
@@ -345,10 +368,13 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
     const std::size_t n_queries = batch.query_kinds().size();
     if (scratch.answered.size() < n_queries + 1) scratch.answered = std::vector<std::atomic<bool>>(n_queries + 1);
     for (std::size_t q = 0; q <= n_queries; ++q) scratch.answered[q].store(false, std::memory_order_relaxed);
+    static_assert(kTileSize == detail::kHizTile, "HizTile holds the 8 x 8 blocks of one executor tile");
+    const bool hiz = options.hierarchical_z && hiz_allowed_by_environment() && target.format() != DepthFormat::D32F;
+    if (hiz && scratch.hiz_tiles.size() < tiles.count()) scratch.hiz_tiles.resize(tiles.count());
     const ShadeContext ctx{batch,          draw_list,       setup,
                            {target.mutable_values().data(), target.width()},
                            target.width(), target.height(), target.format(),
-                           options.allow_simd, scratch.answered.data()};
+                           options.allow_simd, hiz, scratch.hiz_tiles.data(), scratch.answered.data()};
     auto& tile_counts = scratch.tile_counts;
     reset_lists(tile_counts, tiles.count());
     detail::parallel_for(threads, tiles.count(), [&](std::size_t tile) {

@@ -221,6 +221,41 @@ std::uint64_t raster_rect_avx2(const SetupTri& tri, const DepthState& state, Dep
 #endif
 }
 
+std::uint64_t raster_rect_hiz_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
+                                   HizTile& hiz, bool stop_at_first) {
+#if defined(RASTER_KERNEL_AVX2)
+    const auto plain = [&]<DepthFormat Fmt, DepthFunc F, bool Write>(PixelRect r) {
+        return raster_rect8<Fmt, F, Write>(tri, depth, r, stop_at_first);
+    };
+    // Unsigned min / max of 8 pixels per row (whole 8-pixel blocks; the scalar loop otherwise).
+    const auto scan = [](DepthRows d, int x0, int y0, int x1, int y1, std::uint32_t& lo, std::uint32_t& hi) {
+        if (x1 - x0 != 7) return avx2::stored_bounds(d, x0, y0, x1, y1, lo, hi);
+        __m256i l = _mm256_set1_epi32(-1), h = _mm256_setzero_si256();
+        for (int y = y0; y <= y1; ++y) {
+            const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(d.row(y) + x0));
+            l = _mm256_min_epu32(l, v);
+            h = _mm256_max_epu32(h, v);
+        }
+        __m128i l4 = _mm_min_epu32(_mm256_castsi256_si128(l), _mm256_extracti128_si256(l, 1));
+        __m128i h4 = _mm_max_epu32(_mm256_castsi256_si128(h), _mm256_extracti128_si256(h, 1));
+        l4 = _mm_min_epu32(l4, _mm_shuffle_epi32(l4, 0x4e));
+        h4 = _mm_max_epu32(h4, _mm_shuffle_epi32(h4, 0x4e));
+        l4 = _mm_min_epu32(l4, _mm_shuffle_epi32(l4, 0xb1));
+        h4 = _mm_max_epu32(h4, _mm_shuffle_epi32(h4, 0xb1));
+        lo = static_cast<std::uint32_t>(_mm_cvtsi128_si32(l4));
+        hi = static_cast<std::uint32_t>(_mm_cvtsi128_si32(h4));
+    };
+#else
+    const auto plain = [&]<DepthFormat Fmt, DepthFunc F, bool Write>(PixelRect r) {
+        return avx2::raster_rect_t<Fmt, F, Write>(tri, depth, r, stop_at_first);
+    };
+    const auto scan = [](DepthRows d, int x0, int y0, int x1, int y1, std::uint32_t& lo, std::uint32_t& hi) {
+        avx2::stored_bounds(d, x0, y0, x1, y1, lo, hi);
+    };
+#endif
+    return avx2::raster_rect_hiz_with(tri, state, depth, rect, hiz, stop_at_first, plain, scan);
+}
+
 bool kernel_avx2_available() {
 #if defined(RASTER_KERNEL_AVX2) && (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
     static const bool ok = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");

@@ -64,6 +64,10 @@ class CommandBatch {
 struct ExecuteOptions {
     int threads = 1;
     bool allow_simd = true;  // false: always the portable kernel (tests compare the two)
+    // false: execute() tests every pixel (no per-block depth bounds; tests compare the two). The
+    // environment variable CULLIDE_RASTER_NO_HIZ (set, not "0") also turns it off, for benchmarks.
+    // Results never depend on it.
+    bool hierarchical_z = true;
 };
 
 // True when allow_simd runs the GL-exact AVX2 kernel in this process: it was built (x86-64, GCC or
