@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <limits>
 #include <memory>
+#include <unordered_map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -150,6 +151,7 @@ void draws(const CommandBatch& batch, Draws& d) {
 // The front end's output, one list per draw (a GL-exact draw fills `tris`, an exact-bounds draw
 // `bounds` and its vertex `pool`).
 struct SetupDraws {
+    std::vector<std::uint32_t> src;  // per draw: the draw whose `tris` it uses (itself, or an equal earlier one)
     std::vector<std::vector<detail::SetupTri>> tris;
     std::vector<std::vector<detail::BoundsTri>> bounds;
     std::vector<std::vector<detail::BoundsVertex>> pool;
@@ -166,6 +168,47 @@ void reset_lists(std::vector<std::vector<T>>& lists, std::size_t n) {
     for (std::size_t i = 0; i < n; ++i) lists[i].clear();
 }
 
+// What a GL-exact draw's front end reads: its vertex and index spans (by address: the same
+// triangles) and the state it depends on (the target and rules are the batch's).
+struct SetupKey {
+    const Float4* vertices;
+    std::size_t n_vertices;
+    const std::uint32_t* indices;
+    std::size_t n_indices;
+    int vx, vy, vw, vh;
+    CullFace cull;
+    FrontFace front;
+    bool operator==(const SetupKey&) const = default;
+};
+struct SetupKeyHash {
+    std::size_t operator()(const SetupKey& k) const {
+        std::size_t h = std::hash<const void*>{}(k.vertices) ^ (std::hash<const void*>{}(k.indices) * 31u);
+        h ^= (k.n_indices + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2));
+        return h;
+    }
+};
+using SetupIndex = std::unordered_map<SetupKey, std::uint32_t, SetupKeyHash>;
+
+// Marks draws that repeat an earlier GL-exact draw of the batch (same spans, same front-end state)
+// as users of that draw's setup list: CULLIDE draws each item twice in a batch (its query, then its
+// write), and the setup list is a pure function of the key, so sharing it changes no bit.
+void share_setup(const DepthTarget& target, const CommandBatch& batch, const Draws& draws, SetupDraws& out,
+                 SetupIndex& index) {
+    const auto& cmds = batch.commands();
+    const std::size_t n_draws = draws.cmds.size();
+    out.src.resize(n_draws);
+    index.clear();
+    for (std::size_t d = 0; d < n_draws; ++d) {
+        out.src[d] = static_cast<std::uint32_t>(d);
+        const Command& c = cmds[draws.cmds[d]];
+        if (c.state.mode == RasterMode::ExactBounds || c.double_input) continue;
+        const detail::FrontEndParams p = params_for(target, batch.rules(), c.state);
+        const SetupKey key{c.mesh.vertices.data(), c.mesh.vertices.size(), c.mesh.indices.data(), c.mesh.indices.size(),
+                           p.viewport.x, p.viewport.y, p.viewport.width, p.viewport.height, p.cull_face, p.front_face};
+        out.src[d] = index.try_emplace(key, static_cast<std::uint32_t>(d)).first->second;
+    }
+}
+
 void front_end(const DepthTarget& target, const CommandBatch& batch, const Draws& draws, int threads,
                SetupDraws& out, std::vector<std::vector<detail::SetupTri>>& piece_out) {
     const auto& cmds = batch.commands();
@@ -180,6 +223,7 @@ void front_end(const DepthTarget& target, const CommandBatch& batch, const Draws
     };
     std::vector<Piece> pieces;
     for (std::size_t d = 0; d < n_draws; ++d) {
+        if (out.src[d] != d) continue;  // shares an earlier draw's list
         const Command& c = cmds[draws.cmds[d]];
         const std::size_t n = c.state.mode == RasterMode::ExactBounds ? 0 : c.mesh.indices.size() / 3 * 3;
         if (threads == 1 || n <= 3 * kFrontEndPiece) {
@@ -243,8 +287,9 @@ void bin(const SetupDraws& setup, std::size_t n_draws, const Tiles& tiles, int t
                 for (int tx = bx0 / kTileSize; tx <= bx1 / kTileSize; ++tx) add(d, t, tx, ty);
         };
         for (std::size_t d = 0; d < n_draws; ++d) {
-            for (std::size_t t = 0; t < setup.tris[d].size(); ++t) {
-                const auto& tri = setup.tris[d][t];
+            const auto& tris = setup.tris[setup.src[d]];
+            for (std::size_t t = 0; t < tris.size(); ++t) {
+                const auto& tri = tris[t];
                 const int ty0 = std::max(tri.y0 / kTileSize, band_ty0), ty1 = std::min(tri.y1 / kTileSize, band_ty1);
                 if (ty0 > ty1) continue;
                 if (tri.y0 / kTileSize == tri.y1 / kTileSize && tri.x0 / kTileSize == tri.x1 / kTileSize) {
@@ -322,7 +367,7 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
             if (any_only && ((!counts.empty() && counts.back().first == q) ||
                              ctx.answered[q].load(std::memory_order_relaxed)))
                 continue;
-            const auto& tri = ctx.setup.tris[r.draw][r.tri];
+            const auto& tri = ctx.setup.tris[ctx.setup.src[r.draw]][r.tri];
             const detail::PixelRect rect = clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1);
             passed = hiz != nullptr ? detail::raster_rect_hiz(tri, depth_state, ctx.depth, rect, *hiz, ctx.allow_simd, any_only)
                              : detail::raster_rect(tri, depth_state, ctx.depth, rect, ctx.allow_simd, any_only);
@@ -354,10 +399,12 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
         std::vector<std::vector<std::pair<std::uint32_t, std::uint64_t>>> tile_counts;
         std::vector<std::atomic<bool>> answered;
         std::vector<detail::HizTile> hiz_tiles;
+        SetupIndex setup_index;
     };
     thread_local Scratch scratch;
     Draws& draw_list = scratch.draw_list;
     draws(batch, draw_list);
+    share_setup(target, batch, draw_list, scratch.setup, scratch.setup_index);
     front_end(target, batch, draw_list, threads, scratch.setup, scratch.piece_out);
     const SetupDraws& setup = scratch.setup;
     const Tiles tiles{(target.width() + kTileSize - 1) / kTileSize, (target.height() + kTileSize - 1) / kTileSize};
