@@ -21,7 +21,7 @@ namespace raster {
 namespace {
 
 constexpr std::uint32_t kNoQuery = std::numeric_limits<std::uint32_t>::max();
-constexpr int kTileSize = 64;  // llvmpipe's tile size; one task owns one tile
+constexpr int kTileSize = kExecuteTileSize;  // llvmpipe's tile size (64); one task owns one tile
 
 detail::FrontEndParams params_for(const DepthTarget& target, RasterRules rules, const DrawState& s) {
     detail::FrontEndParams p{};
@@ -327,6 +327,7 @@ struct ShadeContext {
     bool allow_simd;
     bool hiz;                     // hierarchical Z on D16 / D24 targets (pipeline.h, HizTile)
     detail::HizTile* hiz_tiles;   // per tile, owned by the tile's task
+    std::uint8_t* written_tiles;  // per tile: set to 1 when a writing draw ran in it (or nullptr)
     std::atomic<bool>* answered;  // per query: an any-samples query already has a passing sample
 };
 
@@ -348,6 +349,7 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
         hiz->tile = {x0, y0, x1, y1};
         hiz->valid = 0;  // bounds are read from the buffer afresh in every batch
     }
+    bool wrote = false;
     for (const Ref& r : bin) {
         const std::uint32_t cmd = ctx.draws.cmds[r.draw];
         const Command& c = cmds[cmd];
@@ -355,6 +357,7 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
         const std::uint32_t q = ctx.draws.cmd_query[cmd];
         std::uint64_t passed;
         if (c.state.mode == RasterMode::ExactBounds) {
+            if (c.state.depth_write) wrote = true;
             const auto& tri = ctx.setup.bounds[r.draw][r.tri];
             passed = detail::bounds_rect(tri, ctx.setup.pool[r.draw].data(), depth_state, ctx.depth,
                                          clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1));
@@ -367,6 +370,7 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
             if (any_only && ((!counts.empty() && counts.back().first == q) ||
                              ctx.answered[q].load(std::memory_order_relaxed)))
                 continue;
+            if (c.state.depth_write) wrote = true;
             const auto& tri = ctx.setup.tris[ctx.setup.src[r.draw]][r.tri];
             const detail::PixelRect rect = clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1);
             passed = hiz != nullptr ? detail::raster_rect_hiz(tri, depth_state, ctx.depth, rect, *hiz, ctx.allow_simd, any_only)
@@ -377,6 +381,9 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
         if (!counts.empty() && counts.back().first == q) counts.back().second += passed;
         else counts.emplace_back(q, passed);
     }
+    if (wrote && ctx.written_tiles != nullptr)
+        ctx.written_tiles[static_cast<std::size_t>(ty) * static_cast<std::size_t>((ctx.width + kTileSize - 1) / kTileSize) +
+                          static_cast<std::size_t>(tx)] = 1;
 }
 
 }  // namespace
@@ -415,13 +422,17 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
     const std::size_t n_queries = batch.query_kinds().size();
     if (scratch.answered.size() < n_queries + 1) scratch.answered = std::vector<std::atomic<bool>>(n_queries + 1);
     for (std::size_t q = 0; q <= n_queries; ++q) scratch.answered[q].store(false, std::memory_order_relaxed);
+    if (options.written_tiles != nullptr && options.written_tiles->size() != tiles.count())
+        options.written_tiles->assign(tiles.count(), 0);
     static_assert(kTileSize == detail::kHizTile, "HizTile holds the 8 x 8 blocks of one executor tile");
     const bool hiz = options.hierarchical_z && hiz_allowed_by_environment() && target.format() != DepthFormat::D32F;
     if (hiz && scratch.hiz_tiles.size() < tiles.count()) scratch.hiz_tiles.resize(tiles.count());
     const ShadeContext ctx{batch,          draw_list,       setup,
                            {target.mutable_values().data(), target.width()},
                            target.width(), target.height(), target.format(),
-                           options.allow_simd, hiz, scratch.hiz_tiles.data(), scratch.answered.data()};
+                           options.allow_simd, hiz, scratch.hiz_tiles.data(),
+                           options.written_tiles != nullptr ? options.written_tiles->data() : nullptr,
+                           scratch.answered.data()};
     auto& tile_counts = scratch.tile_counts;
     reset_lists(tile_counts, tiles.count());
     detail::parallel_for(threads, tiles.count(), [&](std::size_t tile) {

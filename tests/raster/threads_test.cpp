@@ -177,3 +177,56 @@ TEST_CASE("Draws of the same spans share their setup only when the front-end sta
     CHECK(want.value()[0] != want.value()[4]);
     CHECK(want.value()[0] == want.value()[5]);
 }
+
+TEST_CASE("written_tiles flags every tile whose pixels a batch changed, and only tiles with writing draws") {
+    raster_test::SplitMix64 rng(606);
+    std::uint64_t changed_total = 0;
+    for (int rep = 0; rep < 6; ++rep) {
+        CAPTURE(rep);
+        raster_test::Scene scene;
+        raster_test::SceneOptions o;
+        o.width = 333;
+        o.height = 200;
+        o.objects = 80;
+        raster_test::build_scene(scene, rng, o);
+        auto t = raster::DepthTarget::create(333, 200, raster::DepthFormat::D24).value();
+        const std::vector<std::uint32_t> before(t.values().begin(), t.values().end());
+        std::vector<std::uint8_t> flags;
+        raster::ExecuteOptions eo{1 + rep % 2};
+        eo.written_tiles = &flags;
+        REQUIRE(raster::execute(t, scene.batch, eo).ok());
+        const int tiles_x = (333 + raster::kExecuteTileSize - 1) / raster::kExecuteTileSize;
+        REQUIRE(flags.size() == static_cast<std::size_t>(tiles_x) * 4);
+        for (int y = 0; y < 200; ++y)
+            for (int x = 0; x < 333; ++x) {
+                const std::size_t i = static_cast<std::size_t>(y) * 333 + static_cast<std::size_t>(x);
+                if (t.values()[i] == before[i]) continue;
+                ++changed_total;
+                CHECK(flags[static_cast<std::size_t>(y / 64 * tiles_x + x / 64)] == 1);
+            }
+    }
+    CHECK(changed_total > 1000);
+
+    // One written triangle in the bottom-left tile and a query over the whole target: one flag.
+    std::vector<raster::Float4> small{{-1.0f, -1.0f, 0.0f, 1}, {-0.8f, -1.0f, 0.0f, 1}, {-1.0f, -0.8f, 0.0f, 1}};
+    std::vector<raster::Float4> big{{-1, -1, 0.5f, 1}, {3, -1, 0.5f, 1}, {-1, 3, 0.5f, 1}};
+    const std::vector<std::uint32_t> tri{0, 1, 2};
+    raster::CommandBatch batch(200, 200);
+    raster::DrawState w;
+    batch.draw(raster::MeshView{small, tri}, w);
+    raster::DrawState q;
+    q.depth_write = false;
+    batch.begin_query(raster::QueryKind::SamplesPassed);
+    batch.draw(raster::MeshView{big, tri}, q);
+    batch.end_query();
+    auto t = raster::DepthTarget::create(200, 200, raster::DepthFormat::D24).value();
+    std::vector<std::uint8_t> flags(16, 0);
+    raster::ExecuteOptions eo;
+    eo.written_tiles = &flags;
+    const auto r = raster::execute(t, batch, eo);
+    REQUIRE(r.ok());
+    CHECK(r.value()[0] > 30000);  // the query did cover the target
+    std::vector<std::uint8_t> want(16, 0);
+    want[0] = 1;
+    CHECK(flags == want);
+}
