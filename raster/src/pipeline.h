@@ -109,7 +109,8 @@ struct HizTile {
 // exact integers. For finite plane coefficients each correctly rounded fma is monotone in its
 // addend and (as the exact product-sum is linear) in x and in y separately; the clamp and the D16 /
 // D24 encodings are monotone too. So over a rectangle of pixel centres the value is monotone in x
-// for every y and in y for every x, and its minimum and maximum are among the four corners' values.
+// for every y and in y for every x (non-decreasing along the sign of dzdx, dzdy), so its minimum and
+// maximum are the values at two opposite corners of the rectangle.
 std::uint64_t raster_rect_hiz(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
                               HizTile& hiz, bool allow_simd, bool stop_at_first = false);
 std::uint64_t raster_rect_hiz_portable(const SetupTri& tri, const DepthState& state, DepthRows depth,
