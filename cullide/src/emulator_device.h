@@ -2,6 +2,7 @@
 // (pipeline.h) can hold one across frames and change its thread count between them.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,8 +15,8 @@ namespace cullide::detail {
 // raster::execute on a raster::DepthTarget, with the fused visibility pass (raster::VisibilityPass)
 // as its native visibility_pass. The target is kept from one clear to the next while its size and
 // format stay the same, so a device held across frames allocates it once; and a clear restores
-// only the pixels that draws with the depth mask on may have written since the last one (per row,
-// a span of x), because filling a 1024 x 1024 target costs as much as the passes drawn into it.
+// only the 64 x 64 tiles where draws with the depth mask on ran since the last one (the executor
+// reports them), because filling a 1024 x 1024 target costs as much as the passes drawn into it.
 class EmulatorDevice final : public QueryDevice {
    public:
     explicit EmulatorDevice(int threads);
@@ -33,17 +34,13 @@ class EmulatorDevice final : public QueryDevice {
     [[nodiscard]] const raster::DepthTarget* target() const { return target_ ? &*target_ : nullptr; }
 
    private:
-    // Widens row y's written span to [x0, x1] (clamped to the target).
-    void mark(int y, int x0, int x1);
-    void mark_all();
-    // Marks every pixel a written triangle of `batch` may touch (conservative).
-    void mark_writes(const raster::CommandBatch& batch);
-
     int threads_;
     std::optional<raster::DepthTarget> target_;
-    // Per row of the target: the x span [written_lo_, written_hi_] that may differ from the clear
-    // value (empty when lo > hi).
-    std::vector<int> written_lo_, written_hi_;
+    // Per 64 x 64 tile of the target (raster::kExecuteTileSize, row-major, tiles_x_ per row): 1 when
+    // a draw with the depth mask on was rasterized in it since the last clear (filled in by
+    // raster::execute, ExecuteOptions::written_tiles).
+    std::vector<std::uint8_t> written_tiles_;
+    int tiles_x_ = 1;
 };
 
 }  // namespace cullide::detail

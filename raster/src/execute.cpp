@@ -2,8 +2,10 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdint>
+#include <cstdlib>
 #include <limits>
 #include <memory>
+#include <unordered_map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -19,7 +21,7 @@ namespace raster {
 namespace {
 
 constexpr std::uint32_t kNoQuery = std::numeric_limits<std::uint32_t>::max();
-constexpr int kTileSize = 64;  // llvmpipe's tile size; one task owns one tile
+constexpr int kTileSize = kExecuteTileSize;  // llvmpipe's tile size (64); one task owns one tile
 
 detail::FrontEndParams params_for(const DepthTarget& target, RasterRules rules, const DrawState& s) {
     detail::FrontEndParams p{};
@@ -50,6 +52,15 @@ void setup_bounds_draw(const detail::FrontEndParams& p, const Command& c, std::u
                                           pool);
         }
     }
+}
+
+// CULLIDE_RASTER_NO_HIZ set to anything but "" or "0" turns hierarchical Z off (read once).
+bool hiz_allowed_by_environment() {
+    static const bool ok = [] {
+        const char* v = std::getenv("CULLIDE_RASTER_NO_HIZ");
+        return v == nullptr || v[0] == '\0' || (v[0] == '0' && v[1] == '\0');
+    }();
+    return ok;
 }
 
 void finish_results(const CommandBatch& batch, QueryResults& r) {
@@ -140,6 +151,7 @@ void draws(const CommandBatch& batch, Draws& d) {
 // The front end's output, one list per draw (a GL-exact draw fills `tris`, an exact-bounds draw
 // `bounds` and its vertex `pool`).
 struct SetupDraws {
+    std::vector<std::uint32_t> src;  // per draw: the draw whose `tris` it uses (itself, or an equal earlier one)
     std::vector<std::vector<detail::SetupTri>> tris;
     std::vector<std::vector<detail::BoundsTri>> bounds;
     std::vector<std::vector<detail::BoundsVertex>> pool;
@@ -156,6 +168,47 @@ void reset_lists(std::vector<std::vector<T>>& lists, std::size_t n) {
     for (std::size_t i = 0; i < n; ++i) lists[i].clear();
 }
 
+// What a GL-exact draw's front end reads: its vertex and index spans (by address: the same
+// triangles) and the state it depends on (the target and rules are the batch's).
+struct SetupKey {
+    const Float4* vertices;
+    std::size_t n_vertices;
+    const std::uint32_t* indices;
+    std::size_t n_indices;
+    int vx, vy, vw, vh;
+    CullFace cull;
+    FrontFace front;
+    bool operator==(const SetupKey&) const = default;
+};
+struct SetupKeyHash {
+    std::size_t operator()(const SetupKey& k) const {
+        std::size_t h = std::hash<const void*>{}(k.vertices) ^ (std::hash<const void*>{}(k.indices) * 31u);
+        h ^= (k.n_indices + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2));
+        return h;
+    }
+};
+using SetupIndex = std::unordered_map<SetupKey, std::uint32_t, SetupKeyHash>;
+
+// Marks draws that repeat an earlier GL-exact draw of the batch (same spans, same front-end state)
+// as users of that draw's setup list: CULLIDE draws each item twice in a batch (its query, then its
+// write), and the setup list is a pure function of the key, so sharing it changes no bit.
+void share_setup(const DepthTarget& target, const CommandBatch& batch, const Draws& draws, SetupDraws& out,
+                 SetupIndex& index) {
+    const auto& cmds = batch.commands();
+    const std::size_t n_draws = draws.cmds.size();
+    out.src.resize(n_draws);
+    index.clear();
+    for (std::size_t d = 0; d < n_draws; ++d) {
+        out.src[d] = static_cast<std::uint32_t>(d);
+        const Command& c = cmds[draws.cmds[d]];
+        if (c.state.mode == RasterMode::ExactBounds || c.double_input) continue;
+        const detail::FrontEndParams p = params_for(target, batch.rules(), c.state);
+        const SetupKey key{c.mesh.vertices.data(), c.mesh.vertices.size(), c.mesh.indices.data(), c.mesh.indices.size(),
+                           p.viewport.x, p.viewport.y, p.viewport.width, p.viewport.height, p.cull_face, p.front_face};
+        out.src[d] = index.try_emplace(key, static_cast<std::uint32_t>(d)).first->second;
+    }
+}
+
 void front_end(const DepthTarget& target, const CommandBatch& batch, const Draws& draws, int threads,
                SetupDraws& out, std::vector<std::vector<detail::SetupTri>>& piece_out) {
     const auto& cmds = batch.commands();
@@ -170,6 +223,7 @@ void front_end(const DepthTarget& target, const CommandBatch& batch, const Draws
     };
     std::vector<Piece> pieces;
     for (std::size_t d = 0; d < n_draws; ++d) {
+        if (out.src[d] != d) continue;  // shares an earlier draw's list
         const Command& c = cmds[draws.cmds[d]];
         const std::size_t n = c.state.mode == RasterMode::ExactBounds ? 0 : c.mesh.indices.size() / 3 * 3;
         if (threads == 1 || n <= 3 * kFrontEndPiece) {
@@ -233,8 +287,9 @@ void bin(const SetupDraws& setup, std::size_t n_draws, const Tiles& tiles, int t
                 for (int tx = bx0 / kTileSize; tx <= bx1 / kTileSize; ++tx) add(d, t, tx, ty);
         };
         for (std::size_t d = 0; d < n_draws; ++d) {
-            for (std::size_t t = 0; t < setup.tris[d].size(); ++t) {
-                const auto& tri = setup.tris[d][t];
+            const auto& tris = setup.tris[setup.src[d]];
+            for (std::size_t t = 0; t < tris.size(); ++t) {
+                const auto& tri = tris[t];
                 const int ty0 = std::max(tri.y0 / kTileSize, band_ty0), ty1 = std::min(tri.y1 / kTileSize, band_ty1);
                 if (ty0 > ty1) continue;
                 if (tri.y0 / kTileSize == tri.y1 / kTileSize && tri.x0 / kTileSize == tri.x1 / kTileSize) {
@@ -270,6 +325,9 @@ struct ShadeContext {
     int width, height;
     DepthFormat format;
     bool allow_simd;
+    bool hiz;                     // hierarchical Z on D16 / D24 targets (pipeline.h, HizTile)
+    detail::HizTile* hiz_tiles;   // per tile, owned by the tile's task
+    std::uint8_t* written_tiles;  // per tile: set to 1 when a writing draw ran in it (or nullptr)
     std::atomic<bool>* answered;  // per query: an any-samples query already has a passing sample
 };
 
@@ -283,6 +341,15 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
     };
     const auto& cmds = ctx.batch.commands();
     const auto& query_kinds = ctx.batch.query_kinds();
+    detail::HizTile* const hiz =
+        ctx.hiz ? &ctx.hiz_tiles[static_cast<std::size_t>(ty) * static_cast<std::size_t>((ctx.width + kTileSize - 1) / kTileSize) +
+                                 static_cast<std::size_t>(tx)]
+                : nullptr;
+    if (hiz != nullptr) {
+        hiz->tile = {x0, y0, x1, y1};
+        hiz->valid = 0;  // bounds are read from the buffer afresh in every batch
+    }
+    bool wrote = false;
     for (const Ref& r : bin) {
         const std::uint32_t cmd = ctx.draws.cmds[r.draw];
         const Command& c = cmds[cmd];
@@ -290,9 +357,11 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
         const std::uint32_t q = ctx.draws.cmd_query[cmd];
         std::uint64_t passed;
         if (c.state.mode == RasterMode::ExactBounds) {
+            if (c.state.depth_write) wrote = true;
             const auto& tri = ctx.setup.bounds[r.draw][r.tri];
             passed = detail::bounds_rect(tri, ctx.setup.pool[r.draw].data(), depth_state, ctx.depth,
                                          clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1));
+            if (hiz != nullptr && c.state.depth_write) hiz->valid = 0;  // its writes are not tracked
         } else {
             // Any-samples query with the mask off: once this query has a passing sample (in this
             // tile, or in any tile: the flag), further draws in it change nothing; the kernel also
@@ -301,15 +370,20 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
             if (any_only && ((!counts.empty() && counts.back().first == q) ||
                              ctx.answered[q].load(std::memory_order_relaxed)))
                 continue;
-            const auto& tri = ctx.setup.tris[r.draw][r.tri];
-            passed = detail::raster_rect(tri, depth_state, ctx.depth, clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1),
-                                         ctx.allow_simd, any_only);
+            if (c.state.depth_write) wrote = true;
+            const auto& tri = ctx.setup.tris[ctx.setup.src[r.draw]][r.tri];
+            const detail::PixelRect rect = clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1);
+            passed = hiz != nullptr ? detail::raster_rect_hiz(tri, depth_state, ctx.depth, rect, *hiz, ctx.allow_simd, any_only)
+                             : detail::raster_rect(tri, depth_state, ctx.depth, rect, ctx.allow_simd, any_only);
             if (any_only && passed != 0) ctx.answered[q].store(true, std::memory_order_relaxed);
         }
         if (q == kNoQuery || passed == 0) continue;
         if (!counts.empty() && counts.back().first == q) counts.back().second += passed;
         else counts.emplace_back(q, passed);
     }
+    if (wrote && ctx.written_tiles != nullptr)
+        ctx.written_tiles[static_cast<std::size_t>(ty) * static_cast<std::size_t>((ctx.width + kTileSize - 1) / kTileSize) +
+                          static_cast<std::size_t>(tx)] = 1;
 }
 
 }  // namespace
@@ -331,10 +405,13 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
         std::vector<std::vector<Ref>> bins;
         std::vector<std::vector<std::pair<std::uint32_t, std::uint64_t>>> tile_counts;
         std::vector<std::atomic<bool>> answered;
+        std::vector<detail::HizTile> hiz_tiles;
+        SetupIndex setup_index;
     };
     thread_local Scratch scratch;
     Draws& draw_list = scratch.draw_list;
     draws(batch, draw_list);
+    share_setup(target, batch, draw_list, scratch.setup, scratch.setup_index);
     front_end(target, batch, draw_list, threads, scratch.setup, scratch.piece_out);
     const SetupDraws& setup = scratch.setup;
     const Tiles tiles{(target.width() + kTileSize - 1) / kTileSize, (target.height() + kTileSize - 1) / kTileSize};
@@ -345,10 +422,17 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
     const std::size_t n_queries = batch.query_kinds().size();
     if (scratch.answered.size() < n_queries + 1) scratch.answered = std::vector<std::atomic<bool>>(n_queries + 1);
     for (std::size_t q = 0; q <= n_queries; ++q) scratch.answered[q].store(false, std::memory_order_relaxed);
+    if (options.written_tiles != nullptr && options.written_tiles->size() != tiles.count())
+        options.written_tiles->assign(tiles.count(), 0);
+    static_assert(kTileSize == detail::kHizTile, "HizTile holds the 8 x 8 blocks of one executor tile");
+    const bool hiz = options.hierarchical_z && hiz_allowed_by_environment() && target.format() != DepthFormat::D32F;
+    if (hiz && scratch.hiz_tiles.size() < tiles.count()) scratch.hiz_tiles.resize(tiles.count());
     const ShadeContext ctx{batch,          draw_list,       setup,
                            {target.mutable_values().data(), target.width()},
                            target.width(), target.height(), target.format(),
-                           options.allow_simd, scratch.answered.data()};
+                           options.allow_simd, hiz, scratch.hiz_tiles.data(),
+                           options.written_tiles != nullptr ? options.written_tiles->data() : nullptr,
+                           scratch.answered.data()};
     auto& tile_counts = scratch.tile_counts;
     reset_lists(tile_counts, tiles.count());
     detail::parallel_for(threads, tiles.count(), [&](std::size_t tile) {

@@ -92,11 +92,18 @@ inline std::int64_t edge_at(const SetupTri& t, int i, int px, int py) {
 
 // Depth test (and write) of the 8 pixels px..px+7 of `row` at row centre fy; `cover` marks the
 // pixels to process (full: all 8, plain load and blended store). Returns the passing-lane bits.
-template <DepthFormat Fmt, DepthFunc F, bool Write>
-inline unsigned chunk8(const SetupTri& t, std::uint32_t* row, int px, __m256 fy, __m256i cover, bool full) {
+// The inner fma of the depth plane for the 8 pixels px..px+7: fma(dzdx, x, z0), the same in every row.
+inline __m256 plane_x8(const SetupTri& t, int px) {
     const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     const __m256 fx = _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(px), iota));
-    __m256 z = _mm256_fmadd_ps(_mm256_set1_ps(t.dzdy), fy, _mm256_fmadd_ps(_mm256_set1_ps(t.dzdx), fx, _mm256_set1_ps(t.z0)));
+    return _mm256_fmadd_ps(_mm256_set1_ps(t.dzdx), fx, _mm256_set1_ps(t.z0));
+}
+
+// zx: plane_x8(t, px), computed once per column of chunks by callers that visit it in many rows.
+template <DepthFormat Fmt, DepthFunc F, bool Write>
+inline unsigned chunk8(const SetupTri& t, std::uint32_t* row, int px, __m256 fy, __m256i cover, bool full,
+                       __m256 zx) {
+    __m256 z = _mm256_fmadd_ps(_mm256_set1_ps(t.dzdy), fy, zx);
     z = _mm256_max_ps(z, _mm256_setzero_ps());
     z = _mm256_min_ps(z, _mm256_set1_ps(1.0f));
     const __m256i incoming = encode8<Fmt>(z);
@@ -140,32 +147,42 @@ std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, b
             fits = fits && bound < (std::int64_t{1} << 31);
         }
         if (fits) {
-            __m256i lane_sx[3];
+            // At most two columns of 8 pixels (width <= 16). Per column, set up once: the lanes'
+            // edge values in the first row (stepped by the y steps per row, every value an edge
+            // value of a pixel of the padded rectangle, so within the bound), the in-rectangle
+            // lanes and the inner fma of the depth plane.
+            const int columns = (rx1 - rx0) / 8 + 1;
+            __m256i e[2][3], in_rect[2], step_y[3];
+            __m256 zx[2];
             #pragma GCC unroll 3
-            for (int i = 0; i < 3; ++i)
-                lane_sx[i] = _mm256_mullo_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(sx[i])), iota);
+            for (int i = 0; i < 3; ++i) step_y[i] = _mm256_set1_epi32(static_cast<std::int32_t>(sy[i]));
+            for (int k = 0; k < columns; ++k) {
+                const int px = rx0 + 8 * k;
+                in_rect[k] = _mm256_cmpgt_epi32(_mm256_set1_epi32(rx1 - px + 1), iota);
+                zx[k] = plane_x8(t, px);
+                #pragma GCC unroll 3
+                for (int i = 0; i < 3; ++i) {
+                    const __m256i lane_sx = _mm256_mullo_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(sx[i])), iota);
+                    e[k][i] = _mm256_sub_epi32(
+                        _mm256_set1_epi32(static_cast<std::int32_t>(e_row[i] - sx[i] * 8 * k)), lane_sx);
+                }
+            }
             const __m256i zero_i = _mm256_setzero_si256();
             for (int py = ry0; py <= ry1; ++py) {
                 std::uint32_t* row = depth.row(py);
                 const __m256 fy = _mm256_set1_ps(static_cast<float>(py));
-                std::int32_t e_chunk[3];
-                #pragma GCC unroll 3
-                for (int i = 0; i < 3; ++i) e_chunk[i] = static_cast<std::int32_t>(e_row[i]);
-                for (int px = rx0; px <= rx1; px += 8) {
-                    __m256i cover = _mm256_cmpgt_epi32(_mm256_set1_epi32(rx1 - px + 1), iota);
+                for (int k = 0; k < columns; ++k) {
+                    __m256i cover = in_rect[k];
                     #pragma GCC unroll 3
                     for (int i = 0; i < 3; ++i) {
-                        const __m256i e = _mm256_sub_epi32(_mm256_set1_epi32(e_chunk[i]), lane_sx[i]);
-                        cover = _mm256_and_si256(cover, _mm256_cmpgt_epi32(e, zero_i));
-                        e_chunk[i] -= static_cast<std::int32_t>(sx[i] * 8);  // within the bound
+                        cover = _mm256_and_si256(cover, _mm256_cmpgt_epi32(e[k][i], zero_i));
+                        e[k][i] = _mm256_add_epi32(e[k][i], step_y[i]);  // the next row (unused after the last)
                     }
                     const unsigned m = lanes(cover);
                     if (m == 0) continue;
                     passed += static_cast<unsigned>(
-                        std::popcount(chunk8<Fmt, F, Write>(t, row, px, fy, cover, m == 0xffu)));
+                        std::popcount(chunk8<Fmt, F, Write>(t, row, rx0 + 8 * k, fy, cover, m == 0xffu, zx[k])));
                 }
-                #pragma GCC unroll 3
-                for (int i = 0; i < 3; ++i) e_row[i] += sy[i];
                 if (stop_at_first && passed != 0) return passed;
             }
             return passed;
@@ -197,10 +214,10 @@ std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, b
         const int ihi = static_cast<int>(hi);
         int px = static_cast<int>(lo);
         for (; px + 7 <= ihi; px += 8)
-            passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(t, row, px, fy, all, true)));
+            passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(t, row, px, fy, all, true, plane_x8(t, px))));
         if (px <= ihi) {
             const __m256i cover = _mm256_cmpgt_epi32(_mm256_set1_epi32(ihi - px + 1), iota);
-            passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(t, row, px, fy, cover, false)));
+            passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(t, row, px, fy, cover, false, plane_x8(t, px))));
         }
         if (stop_at_first && passed != 0) return passed;
     }
@@ -219,6 +236,41 @@ std::uint64_t raster_rect_avx2(const SetupTri& tri, const DepthState& state, Dep
 #else
     return avx2::raster_rect_kernel(tri, state, depth, rect, stop_at_first);
 #endif
+}
+
+std::uint64_t raster_rect_hiz_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
+                                   HizTile& hiz, bool stop_at_first) {
+#if defined(RASTER_KERNEL_AVX2)
+    const auto plain = [&]<DepthFormat Fmt, DepthFunc F, bool Write>(PixelRect r) {
+        return raster_rect8<Fmt, F, Write>(tri, depth, r, stop_at_first);
+    };
+    // Unsigned min / max of 8 pixels per row (whole 8-pixel blocks; the scalar loop otherwise).
+    const auto scan = [](DepthRows d, int x0, int y0, int x1, int y1, std::uint32_t& lo, std::uint32_t& hi) {
+        if (x1 - x0 != 7) return avx2::stored_bounds(d, x0, y0, x1, y1, lo, hi);
+        __m256i l = _mm256_set1_epi32(-1), h = _mm256_setzero_si256();
+        for (int y = y0; y <= y1; ++y) {
+            const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(d.row(y) + x0));
+            l = _mm256_min_epu32(l, v);
+            h = _mm256_max_epu32(h, v);
+        }
+        __m128i l4 = _mm_min_epu32(_mm256_castsi256_si128(l), _mm256_extracti128_si256(l, 1));
+        __m128i h4 = _mm_max_epu32(_mm256_castsi256_si128(h), _mm256_extracti128_si256(h, 1));
+        l4 = _mm_min_epu32(l4, _mm_shuffle_epi32(l4, 0x4e));
+        h4 = _mm_max_epu32(h4, _mm_shuffle_epi32(h4, 0x4e));
+        l4 = _mm_min_epu32(l4, _mm_shuffle_epi32(l4, 0xb1));
+        h4 = _mm_max_epu32(h4, _mm_shuffle_epi32(h4, 0xb1));
+        lo = static_cast<std::uint32_t>(_mm_cvtsi128_si32(l4));
+        hi = static_cast<std::uint32_t>(_mm_cvtsi128_si32(h4));
+    };
+#else
+    const auto plain = [&]<DepthFormat Fmt, DepthFunc F, bool Write>(PixelRect r) {
+        return avx2::raster_rect_t<Fmt, F, Write>(tri, depth, r, stop_at_first);
+    };
+    const auto scan = [](DepthRows d, int x0, int y0, int x1, int y1, std::uint32_t& lo, std::uint32_t& hi) {
+        avx2::stored_bounds(d, x0, y0, x1, y1, lo, hi);
+    };
+#endif
+    return avx2::raster_rect_hiz_with(tri, state, depth, rect, hiz, stop_at_first, plain, scan);
 }
 
 bool kernel_avx2_available() {

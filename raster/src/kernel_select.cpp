@@ -21,4 +21,11 @@ std::uint64_t raster_rect(const SetupTri& tri, const DepthState& state, DepthRow
     return raster_rect_portable(tri, state, depth, rect, stop_at_first);
 }
 
+std::uint64_t raster_rect_hiz(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
+                              HizTile& hiz, bool allow_simd, bool stop_at_first) {
+    if (allow_simd && kernel_avx2_available() && simd_allowed_by_environment())
+        return raster_rect_hiz_avx2(tri, state, depth, rect, hiz, stop_at_first);
+    return raster_rect_hiz_portable(tri, state, depth, rect, hiz, stop_at_first);
+}
+
 }  // namespace raster::detail

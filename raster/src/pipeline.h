@@ -86,6 +86,38 @@ inline std::uint64_t raster_rect_avx2(const SetupTri& tri, DepthFormat format, D
                                       bool stop_at_first) {
     return raster_rect_avx2(tri, {format, func, write}, {depth, stride}, {rx0, ry0, rx1, ry1}, stop_at_first);
 }
+// Hierarchical Z (issue #17): bounds of the stored depth per 8 x 8 pixel block of one 64 x 64 tile,
+// so that a query triangle (depth mask off) whose depth test certainly fails over a whole block
+// skips it without touching its pixels. Kept by the tile's task (no sharing between threads) for
+// one batch: a block's bounds are read from the buffer the first time a query meets it (`valid`
+// bit); a writing draw runs the plain kernel and clears the valid bits of the blocks it touches.
+// Only for D16 / D24 (stored values compare as unsigned integers, a total order whatever they
+// hold); D32F draws take the plain kernel.
+inline constexpr int kHizTile = 64;   // the executor's tile side (execute.cpp's kTileSize)
+inline constexpr int kHizBlock = 8;   // block side: 8 x 8 blocks per tile, one bit each in `valid`
+struct HizTile {
+    PixelRect tile;            // the tile's pixels (inside the target; smaller at the right/top edge)
+    std::uint64_t valid = 0;   // bit by * 8 + bx: lo/hi of block (bx, by) hold bounds
+    std::uint32_t lo[64];      // every stored value of the block is >= lo ...
+    std::uint32_t hi[64];      // ... and <= hi
+};
+// raster_rect with the tile's block bounds: skips the blocks where the depth test certainly fails,
+// runs the kernel on the rest (in runs of blocks); writing draws run it on all of rect. `rect` lies
+// inside hiz.tile. Same samples and the same stored values as raster_rect on `rect`: the skipped
+// blocks have no passing sample by the bound below.
+// The bound: a pixel's incoming value is enc(clamp(fma(dzdy, y, fma(dzdx, x, z0)))) with float x, y
+// exact integers. For finite plane coefficients each correctly rounded fma is monotone in its
+// addend and (as the exact product-sum is linear) in x and in y separately; the clamp and the D16 /
+// D24 encodings are monotone too. So over a rectangle of pixel centres the value is monotone in x
+// for every y and in y for every x (non-decreasing along the sign of dzdx, dzdy), so its minimum and
+// maximum are the values at two opposite corners of the rectangle.
+std::uint64_t raster_rect_hiz(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
+                              HizTile& hiz, bool allow_simd, bool stop_at_first = false);
+std::uint64_t raster_rect_hiz_portable(const SetupTri& tri, const DepthState& state, DepthRows depth,
+                                       PixelRect rect, HizTile& hiz, bool stop_at_first);
+std::uint64_t raster_rect_hiz_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
+                                   HizTile& hiz, bool stop_at_first);
+
 // True when the CPU has AVX2 and FMA and this build has the AVX2 kernel (x86-64 GCC/Clang).
 bool kernel_avx2_available();
 // False when CULLIDE_RASTER_NO_SIMD forces the portable kernel everywhere (read once).

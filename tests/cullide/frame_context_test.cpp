@@ -1,7 +1,8 @@
 // FrameContext (cullide/pipeline.h): a context reused across frames gives the same bits as a fresh
 // call, whatever ran through it before (methods, resolutions, depth formats, scene sizes, thread
 // counts, failed frames), and it is movable. The emulator device's partial clear (it restores only
-// the spans draws may have written) leaves the whole target at depth 1.0, as a full clear does.
+// the tiles where raster::execute ran writing draws) leaves the whole target at depth 1.0, as a
+// full clear does.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -166,7 +167,7 @@ TEST_CASE("A FrameContext stays usable after a failed frame and after a move") {
 }
 
 TEST_CASE("The emulator's partial clear leaves every pixel at depth 1.0 after random written triangles") {
-    // Sizes at and above the tracking threshold (256 x 256), not square, in every format; triangles
+    // Sizes of whole and partial 64 x 64 tiles, not square, in every format; triangles
     // inside, across and far outside the clip volume, thin ones, both raster modes, full and
     // partial viewports.
     test::Rng rng(0x7A11F7A3E5ULL);

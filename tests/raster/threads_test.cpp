@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <iterator>
+#include <vector>
 
 #include "raster/raster.h"
 #include "scene_gen.h"
@@ -116,4 +118,115 @@ TEST_CASE("The AVX2+FMA kernel and the portable kernel give the same bits") {
             CHECK(std::equal(va.begin(), va.end(), vb.begin(), vb.end()));
         }
     }
+}
+
+TEST_CASE("Draws of the same spans share their setup only when the front-end state is equal") {
+    // One mesh drawn under several culling / facing / viewport states in one batch (the executor
+    // shares a setup list between draws of the same spans and state): each query must equal the
+    // reference's and the answer of a batch that draws separate copies of the mesh (no sharing).
+    raster_test::SplitMix64 rng(4242);
+    std::vector<raster::Float4> v;
+    std::vector<std::uint32_t> idx;
+    for (int t = 0; t < 60; ++t) {
+        for (int k = 0; k < 3; ++k) {
+            idx.push_back(static_cast<std::uint32_t>(v.size()));
+            v.push_back({rng.uniform(-1.1f, 1.1f), rng.uniform(-1.1f, 1.1f), rng.uniform(-0.9f, 0.9f), 1});
+        }
+    }
+    struct St {
+        raster::CullFace cull;
+        raster::FrontFace front;
+        bool sub_viewport;
+    };
+    const St states[] = {{raster::CullFace::None, raster::FrontFace::CCW, false},
+                         {raster::CullFace::Back, raster::FrontFace::CCW, false},
+                         {raster::CullFace::Front, raster::FrontFace::CCW, false},
+                         {raster::CullFace::Back, raster::FrontFace::CW, false},
+                         {raster::CullFace::None, raster::FrontFace::CCW, true},
+                         {raster::CullFace::None, raster::FrontFace::CCW, false}};
+    std::vector<std::vector<raster::Float4>> copies(std::size(states), v);
+    raster::CommandBatch shared(150, 100), separate(150, 100);
+    for (std::size_t i = 0; i < std::size(states); ++i) {
+        raster::DrawState s;
+        s.depth_write = false;
+        s.depth_func = raster::DepthFunc::Always;
+        s.cull_face = states[i].cull;
+        s.front_face = states[i].front;
+        if (states[i].sub_viewport) s.viewport = raster::Viewport{10, 5, 90, 70};
+        shared.begin_query(raster::QueryKind::SamplesPassed);
+        shared.draw(raster::MeshView{v, idx}, s);
+        shared.end_query();
+        separate.begin_query(raster::QueryKind::SamplesPassed);
+        separate.draw(raster::MeshView{copies[i], idx}, s);
+        separate.end_query();
+    }
+    auto a = raster::DepthTarget::create(150, 100, raster::DepthFormat::D24).value();
+    auto b = raster::DepthTarget::create(150, 100, raster::DepthFormat::D24).value();
+    auto c = raster::DepthTarget::create(150, 100, raster::DepthFormat::D24).value();
+    const auto want = raster::execute_reference(a, shared);
+    const auto got = raster::execute(b, shared, raster::ExecuteOptions{2});
+    const auto sep = raster::execute(c, separate, raster::ExecuteOptions{2});
+    REQUIRE(want.ok());
+    REQUIRE(got.ok());
+    REQUIRE(sep.ok());
+    CHECK(got.value() == want.value());
+    CHECK(sep.value() == want.value());
+    // The states really differ (culling and the viewport change the counts): not a vacuous check.
+    CHECK(want.value()[0] != want.value()[1]);
+    CHECK(want.value()[1] != want.value()[2]);
+    CHECK(want.value()[0] != want.value()[4]);
+    CHECK(want.value()[0] == want.value()[5]);
+}
+
+TEST_CASE("written_tiles flags every tile whose pixels a batch changed, and only tiles with writing draws") {
+    raster_test::SplitMix64 rng(606);
+    std::uint64_t changed_total = 0;
+    for (int rep = 0; rep < 6; ++rep) {
+        CAPTURE(rep);
+        raster_test::Scene scene;
+        raster_test::SceneOptions o;
+        o.width = 333;
+        o.height = 200;
+        o.objects = 80;
+        raster_test::build_scene(scene, rng, o);
+        auto t = raster::DepthTarget::create(333, 200, raster::DepthFormat::D24).value();
+        const std::vector<std::uint32_t> before(t.values().begin(), t.values().end());
+        std::vector<std::uint8_t> flags;
+        raster::ExecuteOptions eo{1 + rep % 2};
+        eo.written_tiles = &flags;
+        REQUIRE(raster::execute(t, scene.batch, eo).ok());
+        const int tiles_x = (333 + raster::kExecuteTileSize - 1) / raster::kExecuteTileSize;
+        REQUIRE(flags.size() == static_cast<std::size_t>(tiles_x) * 4);
+        for (int y = 0; y < 200; ++y)
+            for (int x = 0; x < 333; ++x) {
+                const std::size_t i = static_cast<std::size_t>(y) * 333 + static_cast<std::size_t>(x);
+                if (t.values()[i] == before[i]) continue;
+                ++changed_total;
+                CHECK(flags[static_cast<std::size_t>(y / 64 * tiles_x + x / 64)] == 1);
+            }
+    }
+    CHECK(changed_total > 1000);
+
+    // One written triangle in the bottom-left tile and a query over the whole target: one flag.
+    std::vector<raster::Float4> small{{-1.0f, -1.0f, 0.0f, 1}, {-0.8f, -1.0f, 0.0f, 1}, {-1.0f, -0.8f, 0.0f, 1}};
+    std::vector<raster::Float4> big{{-1, -1, 0.5f, 1}, {3, -1, 0.5f, 1}, {-1, 3, 0.5f, 1}};
+    const std::vector<std::uint32_t> tri{0, 1, 2};
+    raster::CommandBatch batch(200, 200);
+    raster::DrawState w;
+    batch.draw(raster::MeshView{small, tri}, w);
+    raster::DrawState q;
+    q.depth_write = false;
+    batch.begin_query(raster::QueryKind::SamplesPassed);
+    batch.draw(raster::MeshView{big, tri}, q);
+    batch.end_query();
+    auto t = raster::DepthTarget::create(200, 200, raster::DepthFormat::D24).value();
+    std::vector<std::uint8_t> flags(16, 0);
+    raster::ExecuteOptions eo;
+    eo.written_tiles = &flags;
+    const auto r = raster::execute(t, batch, eo);
+    REQUIRE(r.ok());
+    CHECK(r.value()[0] > 30000);  // the query did cover the target
+    std::vector<std::uint8_t> want(16, 0);
+    want[0] = 1;
+    CHECK(flags == want);
 }

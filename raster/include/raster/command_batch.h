@@ -64,7 +64,20 @@ class CommandBatch {
 struct ExecuteOptions {
     int threads = 1;
     bool allow_simd = true;  // false: always the portable kernel (tests compare the two)
+    // false: execute() tests every pixel (no per-block depth bounds; tests compare the two). The
+    // environment variable CULLIDE_RASTER_NO_HIZ (set, not "0") also turns it off, for benchmarks.
+    // Results never depend on it.
+    bool hierarchical_z = true;
+    // When set (execute() only): one entry per kExecuteTileSize square tile of the target, row-major
+    // from the bottom left ((width + 63) / 64 per row); execute() sets to 1 the entries of the tiles
+    // where a draw with the depth mask on was rasterized (a superset of the pixels it wrote) and
+    // leaves the others as they are, so that a caller can restore only those tiles. Resized to the
+    // tile count (new entries 0) when its size differs.
+    std::vector<std::uint8_t>* written_tiles = nullptr;
 };
+
+// The side of execute()'s tiles (ExecuteOptions::written_tiles).
+inline constexpr int kExecuteTileSize = 64;
 
 // True when allow_simd runs the GL-exact AVX2 kernel in this process: it was built (x86-64, GCC or
 // Clang), the CPU has AVX2 and FMA, and CULLIDE_RASTER_NO_SIMD is unset or 0. For reports such as
