@@ -142,12 +142,16 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
             if (job.positions) {
                 // Branch-free into a local flag: a store to job_ok (bytes, which may alias anything)
                 // in the loop made the compiler reload the mesh on every coordinate.
-                bool bad = false;
+                // Counted as integers (bitwise on bool is what clang's -Wbitwise-instead-of-logical
+                // rejects; short-circuit || would bring the branches back).
+                unsigned bad = 0;
                 for (std::size_t v = job.first; v < job.last; ++v) {
                     const Vec3 p = m.positions[v];
-                    bad |= !predicate_coordinate_ok(p.x) | !predicate_coordinate_ok(p.y) | !predicate_coordinate_ok(p.z);
+                    bad |= static_cast<unsigned>(!predicate_coordinate_ok(p.x)) |
+                           static_cast<unsigned>(!predicate_coordinate_ok(p.y)) |
+                           static_cast<unsigned>(!predicate_coordinate_ok(p.z));
                 }
-                if (bad) job_ok[j] = 0;
+                if (bad != 0) job_ok[j] = 0;
                 return;
             }
             const std::size_t count = m.positions.size();
