@@ -184,11 +184,7 @@ TEST_CASE("written_tiles flags every tile whose pixels a batch changed, and only
     for (int rep = 0; rep < 6; ++rep) {
         CAPTURE(rep);
         raster_test::Scene scene;
-        raster_test::SceneOptions o;
-        o.width = 333;
-        o.height = 200;
-        o.objects = 80;
-        raster_test::build_scene(scene, rng, o);
+        raster_test::build_scene(scene, rng, {.width = 333, .height = 200, .objects = 80});
         auto t = raster::DepthTarget::create(333, 200, raster::DepthFormat::D24).value();
         const std::vector<std::uint32_t> before(t.values().begin(), t.values().end());
         std::vector<std::uint8_t> flags;
