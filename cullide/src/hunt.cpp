@@ -17,6 +17,7 @@
 #include "cullide/predicates.h"
 #include "cullide/tri_tri.h"
 #include "cullide/visibility.h"
+#include "box_mesh.h"
 #include "scene_math.h"
 
 namespace cullide::hunt {
@@ -50,21 +51,6 @@ Mesh triangles_mesh(std::string name, const std::vector<std::array<Vec3, 3>>& tr
         const auto base = static_cast<std::uint32_t>(m.positions.size());
         m.positions.insert(m.positions.end(), t.begin(), t.end());
         m.triangles.push_back({base, base + 1, base + 2});
-    }
-    return m;
-}
-
-// An axis-aligned box, 8 shared vertices, 12 triangles facing out.
-Mesh box(std::string name, Vec3 lo, Vec3 hi) {
-    Mesh m;
-    m.name = std::move(name);
-    for (int i = 0; i < 8; ++i)
-        m.positions.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
-    const std::uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                                   {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-    for (const auto& f : q) {
-        m.triangles.push_back({f[0], f[1], f[2]});
-        m.triangles.push_back({f[0], f[2], f[3]});
     }
     return m;
 }
@@ -202,11 +188,11 @@ Frame grazing(Rng& r) {
                 const double s = 0.25 * r.between(1, 3);
                 Vec3 lo{0.25 * r.between(-3, 2), 0.25 * r.between(-3, 2), 0.25 * r.between(-3, 2)};
                 Vec3 hi{lo.x + s, lo.y + s, lo.z + s};
-                f.push_back(box("box_" + std::to_string(o), lo, hi));
+                f.push_back(detail::box_mesh("box_" + std::to_string(o), lo, hi));
                 Vec3 d{0, 0, 0};
                 for (int k = 0; k < 3; ++k)
                     if (k == 0 || r.coin()) d[k] = s;
-                f.push_back(box("box_" + std::to_string(o) + "b", lo + d, hi + d));
+                f.push_back(detail::box_mesh("box_" + std::to_string(o) + "b", lo + d, hi + d));
                 break;
             }
         }
@@ -261,7 +247,7 @@ Mesh crosser(Rng& r, std::string name, int axis, double c, double pu, double pv)
     centre[v] = pv;
     if (r.coin(60)) {
         Vec3 lo{centre.x - h, centre.y - h, centre.z - h}, hi{centre.x + h, centre.y + h, centre.z + h};
-        return box(std::move(name), lo, hi);
+        return detail::box_mesh(std::move(name), lo, hi);
     }
     return tetra(std::move(name), centre + r.point(-h, h), centre + r.point(-h, h), centre + r.point(-h, h),
                  centre + r.point(-h, h));

@@ -24,6 +24,7 @@
 #include "cullide/mesh_io.h"
 #include "cullide/pipeline.h"
 #include "cullide/scenes.h"
+#include "box_mesh.h"
 
 namespace {
 
@@ -34,6 +35,7 @@ using cullide::Method;
 using cullide::RunOptions;
 using cullide::TrianglePair;
 using cullide::Vec3;
+using cullide::detail::box_mesh;
 namespace hunt = cullide::hunt;
 
 struct Outcome {
@@ -70,28 +72,13 @@ std::uint64_t triangles(const Frame& f) {
 
 // The planted miss: a wall in the plane x = 0 (two triangles, seen edge-on in the y and z views,
 // where it covers no pixel and is pruned as fully visible), crossed by a box, plus a distant box.
-// An axis-aligned box: 8 shared vertices, 12 triangles facing out.
-Mesh box(std::string name, Vec3 lo, Vec3 hi) {
-    Mesh m;
-    m.name = std::move(name);
-    for (int i = 0; i < 8; ++i)
-        m.positions.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
-    const std::uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                                   {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-    for (const auto& f : q) {
-        m.triangles.push_back({f[0], f[1], f[2]});
-        m.triangles.push_back({f[0], f[2], f[3]});
-    }
-    return m;
-}
-
 Frame planted_wall() {
     Mesh wall;
     wall.name = "wall";
     wall.positions = {{0, -1, -1}, {0, 1, -1}, {0, 1, 1}, {0, -1, 1}};
     wall.triangles = {{0, 1, 2}, {0, 2, 3}};
-    return {wall, box("crosser", {-0.25, 0.1, 0.2}, {0.3, 0.45, 0.6}),
-            box("far", {2, 2, 2}, {2.5, 2.5, 2.5})};
+    return {wall, box_mesh("crosser", {-0.25, 0.1, 0.2}, {0.3, 0.45, 0.6}),
+            box_mesh("far", {2, 2, 2}, {2.5, 2.5, 2.5})};
 }
 
 RunOptions gl_exact_cullide() {
@@ -183,7 +170,7 @@ TEST_CASE("the planted edge-on miss is shrunk to a smaller frame that still miss
 }
 
 TEST_CASE("boxes touching face to face are missed at any setting, and classified touching") {
-    const Frame touching{box("box", {0, 0, 0}, {1, 1, 1}), box("box", {1, 0.25, 0.25}, {2, 0.75, 0.75})};
+    const Frame touching{box_mesh("box", {0, 0, 0}, {1, 1, 1}), box_mesh("box", {1, 0.25, 0.25}, {2, 0.75, 0.75})};
     cullide::FrameContext context;
     const RunOptions opt = gl_exact_cullide();
     const hunt::Verdict v = hunt::check(touching, opt, context).value();

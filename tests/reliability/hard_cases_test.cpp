@@ -33,6 +33,7 @@
 
 #include "cullide/ground_truth.h"
 #include "cullide/mesh.h"
+#include "box_mesh.h"
 #include "cullide/pipeline.h"
 #include "digest.h"
 #include "rational_tri_tri.h"
@@ -46,20 +47,8 @@ namespace {
 
 // ---- Building blocks --------------------------------------------------------------------------
 
-Mesh box_mesh(const std::string& name, Vec3 lo, Vec3 hi) {
-    Mesh m;
-    m.name = name;
-    for (int i = 0; i < 8; ++i) {
-        m.positions.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
-    }
-    // Two triangles per face, outward winding (winding does not matter to the exact test).
-    const std::uint32_t f[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-    for (const auto& q : f) {
-        m.triangles.push_back({q[0], q[1], q[2]});
-        m.triangles.push_back({q[0], q[2], q[3]});
-    }
-    return m;
-}
+// Boxes: cullide/src/box_mesh.h (two triangles per face; winding does not matter to the exact test).
+using cullide::detail::box_mesh;
 
 Mesh triangle_mesh(const std::string& name, Vec3 a, Vec3 b, Vec3 c) {
     return Mesh{name, {a, b, c}, {{0, 1, 2}}};
