@@ -448,7 +448,7 @@ constexpr std::size_t kGatherChunk = 16384;  // triangles per gather job
 constexpr std::size_t kSlabRefs = 8192;      // about this many refs per slab job
 constexpr std::size_t kSpatialMin = 2048;    // an object worth a spatial order: this many triangles
 constexpr std::uint32_t kSpatialTasks = 8;   // in this many pair tasks (tori: 4-5 tasks an object, 12% slower
-                                             // with the order; leaves: 57, 10% faster)
+                                             // with the order), its blocks loose (loose_blocks)
 
 // The refs a gather job found, per slab of its task.
 using SlabRefs = std::vector<std::vector<TriRef>>;
@@ -544,8 +544,8 @@ void plan_task(TriTask& t, std::span<const ExactObject> objects, std::span<const
 // (self: all), into the slabs their rows touch; flags them in `in_task` (pair tasks).
 // An object's triangles in a spatial order (Morton order of their box centres, 4 bits an axis over
 // the object's box) with the box of each block of kBoxBlock of them. For an object in several pair
-// tasks, where the mesh's own order leaves blocks loose: the big object of leaves (about 40 K
-// triangles in 57 tasks, 1,764 of them in any common box) had every task read all its triangles.
+// tasks whose mesh order leaves blocks loose (loose_blocks): a scrambled mesh has every task read
+// all its triangles.
 struct SpatialOrder {
     std::vector<std::uint32_t> positions;  // positions in spatial order; empty: the mesh's order
     std::vector<Aabb> blocks;              // blocks[b]: the box of positions[b * kBoxBlock ...]
@@ -618,6 +618,21 @@ SpatialOrder spatial_order(const ExactObject& o, int threads) {
         }
     });
     return s;
+}
+
+// Whether the mesh's own order leaves an object's blocks loose: their mean size (the sum of a box's
+// three extents) is more than kLooseBlocks of the object's. A mesh made strip by strip or part by
+// part keeps neighbours together (the tree of leaves, 43.6 K triangles in 57 pair tasks: 0.087, and
+// the order cost a third of the frame's instructions for nothing); a scrambled one does not (the same
+// tree shuffled: 0.73, where the order halves the frame). The loosest fragment of breaking (0.34) is
+// about even either way.
+constexpr double kLooseBlocks = 0.4;
+bool loose_blocks(const ExactObject& o, const TriangleBoxes& boxes) {
+    const auto size = [](const Aabb& b) { return (b.hi.x - b.lo.x) + (b.hi.y - b.lo.y) + (b.hi.z - b.lo.z); };
+    double sum = 0.0;
+    for (const Aabb& b : boxes.blocks) sum += size(b);
+    const double whole = size(o.box);
+    return sum > kLooseBlocks * static_cast<double>(boxes.blocks.size()) * whole;
 }
 
 void gather(const TriTask& t, const ExactObject& o, const TriangleBoxes& boxes, const SpatialOrder& order,
@@ -910,7 +925,8 @@ ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
     for (const TriTask& t : tasks)
         if (!t.self()) ++pair_tasks[t.a], ++pair_tasks[t.b];
     for (std::uint32_t o = 0; o < n; ++o)
-        if (pair_tasks[o] >= kSpatialTasks && objects[o].triangle_boxes.size() >= kSpatialMin) to_order.push_back(o);
+        if (pair_tasks[o] >= kSpatialTasks && objects[o].triangle_boxes.size() >= kSpatialMin && loose_blocks(objects[o], boxes[o]))
+            to_order.push_back(o);
     std::vector<SpatialOrder> orders(n);
     for (const std::uint32_t o : to_order) orders[o] = spatial_order(objects[o], options.threads);  // parallel inside
     std::vector<std::vector<unsigned char>> in_task(n);

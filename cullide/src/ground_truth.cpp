@@ -160,7 +160,7 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
             Aabb* const block_out = blocks.data() + first_block[job.object];
             Aabb all{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
             for (std::size_t b0 = job.first; b0 < job.last; b0 += detail::kBoxBlock) {
-                Aabb block = all;
+                Aabb block{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};  // this block's own
                 const std::size_t b1 = std::min(job.last, b0 + detail::kBoxBlock);
                 for (std::size_t t = b0; t < b1; ++t) {
                     const Tri& tri = m.triangles[t];
