@@ -89,7 +89,12 @@ struct ScanJob {
     bool positions = false;
     std::size_t first = 0, last = 0;
 };
-constexpr std::size_t kScanChunk = 16384;  // a multiple of detail::kBoxBlock
+// A multiple of detail::kBoxBlock. Small enough that a big object makes many jobs: oneTBB splits the
+// job list in halves and a thread that runs dry steals whole jobs, so the tree of leaves' 3 triangle
+// jobs of 16 K and 2 vertex jobs, first in the list, kept the first thread busy while the second
+// finished the 300 small ones (a model of that list, 5 big jobs then 300 small, on a 2-thread
+// arena: 1202 units on the caller, 598 on the worker; as 17 jobs a third the size: 980 and 810).
+constexpr std::size_t kScanChunk = 4096;
 
 // An array the scan jobs construct in place: std::vector's resize would first write every element,
 // on one thread (12 MB on bunny-dragon). Only trivially destructible elements, each constructed by a
