@@ -637,8 +637,8 @@ bool loose_blocks(const ExactObject& o, const TriangleBoxes& boxes) {
 }
 
 void gather(const TriTask& t, const ExactObject& o, const TriangleBoxes& boxes, const SpatialOrder& order,
-            std::uint32_t first, std::uint32_t last, std::span<unsigned char> in_task, SlabRefs& out) {
-    out.assign(static_cast<std::size_t>(t.slabs), {});
+            std::uint32_t first, std::uint32_t last, std::span<unsigned char> in_task,
+            std::span<std::vector<TriRef>> out) {
     const FloatBox common = float_box(t.common);
     const int u = t.gu.axis, v = t.gv.axis;
     const bool spatial = !order.positions.empty();
@@ -940,12 +940,15 @@ ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
     }
     parallel_chunks(options.threads, tasks.size(), [&](std::size_t t) { plan_task(tasks[t], objects, boxes); });
 
-    // Gather jobs: chunks of each side of each task, side a's then side b's.
+    // Gather jobs: chunks of each side of each task cut into slabs, side a's then side b's (a one-slab
+    // task gathers in its slab job: one phase less and no copy of its refs).
     std::vector<GatherJob> jobs;
     std::vector<std::size_t> task_jobs(tasks.size() + 1, 0);  // jobs of task t: [task_jobs[t], task_jobs[t + 1])
     std::vector<std::size_t> side_b(tasks.size(), 0);         // its first side-b job
     for (std::size_t t = 0; t < tasks.size(); ++t) {
         task_jobs[t] = jobs.size();
+        side_b[t] = jobs.size();
+        if (tasks[t].slabs == 1) continue;  // gathered by its slab job
         for (std::uint32_t side = 0; side < (tasks[t].self() ? 1u : 2u); ++side) {
             if (side == 1) side_b[t] = jobs.size();
             const auto count = static_cast<std::uint32_t>(objects[side == 0 ? tasks[t].a : tasks[t].b].triangle_boxes.size());
@@ -972,6 +975,7 @@ ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
         const GatherJob& g = jobs[j];
         const TriTask& t = tasks[g.task];
         const std::uint32_t o = g.side == 0 ? t.a : t.b;
+        gathered[j].resize(static_cast<std::size_t>(t.slabs));
         gather(t, objects[o], boxes[o], orders[o], g.first, g.last, in_task[o], gathered[j]);
     });
 
@@ -989,16 +993,27 @@ ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
         const std::uint32_t ti = slabs[sj].task;
         const TriTask& t = tasks[ti];
         const auto s = static_cast<std::size_t>(slabs[sj].slab);
-        std::size_t total = 0;
-        for (std::size_t j = task_jobs[ti]; j < task_jobs[ti + 1]; ++j) total += gathered[j][s].size();
-        if (total < 2) return;
-        std::vector<TriRef> refs;
-        refs.reserve(total);
-        for (std::size_t j = task_jobs[ti]; j < side_b[ti]; ++j)
-            refs.insert(refs.end(), gathered[j][s].begin(), gathered[j][s].end());
-        const std::size_t n0 = refs.size();
-        for (std::size_t j = side_b[ti]; j < task_jobs[ti + 1]; ++j)
-            refs.insert(refs.end(), gathered[j][s].begin(), gathered[j][s].end());
+        // The slab's refs, side a's then side b's, each in position order (reused by the thread).
+        thread_local std::vector<TriRef> refs;
+        refs.clear();
+        std::size_t n0 = 0;
+        if (t.slabs == 1) {
+            // One slab: gathered here, one side after the other, the same refs in the same order as
+            // gather jobs would give (no second phase, no copy).
+            gather(t, objects[t.a], boxes[t.a], orders[t.a], 0, static_cast<std::uint32_t>(objects[t.a].triangle_boxes.size()),
+                   in_task[t.a], {&refs, 1});
+            n0 = refs.size();
+            if (!t.self())  // even when side a found nothing: side b's in-task flags are counted
+                gather(t, objects[t.b], boxes[t.b], orders[t.b], 0, static_cast<std::uint32_t>(objects[t.b].triangle_boxes.size()),
+                       in_task[t.b], {&refs, 1});
+        } else {
+            for (std::size_t j = task_jobs[ti]; j < side_b[ti]; ++j)
+                refs.insert(refs.end(), gathered[j][s].begin(), gathered[j][s].end());
+            n0 = refs.size();
+            for (std::size_t j = side_b[ti]; j < task_jobs[ti + 1]; ++j)
+                refs.insert(refs.end(), gathered[j][s].begin(), gathered[j][s].end());
+        }
+        if (refs.size() < 2) return;
         if (!t.self() && (n0 == 0 || n0 == refs.size())) return;
         UnitOut& o = out[sj];
         const std::span<const Aabb> boxes_a = objects[t.a].triangle_boxes;
