@@ -1,6 +1,9 @@
 #include "cullide/ground_truth.h"
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <limits>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -82,6 +85,31 @@ Status validate_exact_range(std::span<const Mesh> objects) {
 
 namespace {
 
+// 1 when x is outside the exact range, else 0: !predicate_coordinate_ok(x) on the bits. |x|'s bits
+// as an integer grow with |x| (infinities and NaNs above every finite value), so the range is one
+// unsigned compare, and 0 the one exception. Comparisons of doubles branched on every coordinate of
+// the scan's vertex jobs.
+constexpr unsigned coordinate_bad(double x) {
+    constexpr std::uint64_t kLo = std::bit_cast<std::uint64_t>(kPredicateMinAbs);
+    constexpr std::uint64_t kHi = std::bit_cast<std::uint64_t>(kPredicateMaxAbs);
+    const std::uint64_t m = std::bit_cast<std::uint64_t>(x) & 0x7fffffffffffffffULL;
+    return static_cast<unsigned>(m - kLo > kHi - kLo) & static_cast<unsigned>(m != 0);
+}
+constexpr bool same_as_predicate(double x) { return coordinate_bad(x) == (predicate_coordinate_ok(x) ? 0u : 1u); }
+static_assert(same_as_predicate(0.0) && same_as_predicate(-0.0) && same_as_predicate(1.0) && same_as_predicate(-3.5e7));
+static_assert(same_as_predicate(kPredicateMinAbs) && same_as_predicate(-kPredicateMinAbs) &&
+              same_as_predicate(kPredicateMaxAbs) && same_as_predicate(-kPredicateMaxAbs));
+constexpr double step_bits(double x, std::int64_t by) {  // by floats in x's magnitude, for the checks
+    return std::bit_cast<double>(std::bit_cast<std::uint64_t>(x) + static_cast<std::uint64_t>(by));
+}
+static_assert(same_as_predicate(step_bits(kPredicateMinAbs, -1)) && same_as_predicate(step_bits(kPredicateMaxAbs, 1)) &&
+              same_as_predicate(step_bits(-kPredicateMinAbs, -1)) && same_as_predicate(step_bits(-kPredicateMaxAbs, 1)) &&
+              same_as_predicate(0x1p-1074) && same_as_predicate(-0x1p-1074) && same_as_predicate(1e308));
+static_assert(same_as_predicate(std::numeric_limits<double>::infinity()) &&
+              same_as_predicate(-std::numeric_limits<double>::infinity()) &&
+              same_as_predicate(std::numeric_limits<double>::quiet_NaN()) &&
+              same_as_predicate(-std::numeric_limits<double>::quiet_NaN()));
+
 // One job of exact_pairs' first pass: triangles [first, last) of an object (indices in range, and
 // their boxes) or its positions [first, last) (coordinates in the exact range).
 struct ScanJob {
@@ -156,9 +184,7 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
                 unsigned bad = 0;
                 for (std::size_t v = job.first; v < job.last; ++v) {
                     const Vec3 p = m.positions[v];
-                    bad |= static_cast<unsigned>(!predicate_coordinate_ok(p.x)) |
-                           static_cast<unsigned>(!predicate_coordinate_ok(p.y)) |
-                           static_cast<unsigned>(!predicate_coordinate_ok(p.z));
+                    bad |= coordinate_bad(p.x) | coordinate_bad(p.y) | coordinate_bad(p.z);
                 }
                 if (bad != 0) job_ok[j] = 0;
                 return;
