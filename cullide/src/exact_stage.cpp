@@ -938,27 +938,6 @@ ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
         }
         tasks.push_back(std::move(t));
     }
-    parallel_chunks(options.threads, tasks.size(), [&](std::size_t t) { plan_task(tasks[t], objects, boxes); });
-
-    // Gather jobs: chunks of each side of each task cut into slabs, side a's then side b's (a one-slab
-    // task gathers in its slab job: one phase less and no copy of its refs).
-    std::vector<GatherJob> jobs;
-    std::vector<std::size_t> task_jobs(tasks.size() + 1, 0);  // jobs of task t: [task_jobs[t], task_jobs[t + 1])
-    std::vector<std::size_t> side_b(tasks.size(), 0);         // its first side-b job
-    for (std::size_t t = 0; t < tasks.size(); ++t) {
-        task_jobs[t] = jobs.size();
-        side_b[t] = jobs.size();
-        if (tasks[t].slabs == 1) continue;  // gathered by its slab job
-        for (std::uint32_t side = 0; side < (tasks[t].self() ? 1u : 2u); ++side) {
-            if (side == 1) side_b[t] = jobs.size();
-            const auto count = static_cast<std::uint32_t>(objects[side == 0 ? tasks[t].a : tasks[t].b].triangle_boxes.size());
-            for (std::uint32_t f = 0; f < count; f += kGatherChunk)
-                jobs.push_back({static_cast<std::uint32_t>(t), side, f,
-                                static_cast<std::uint32_t>(std::min<std::size_t>(count, f + kGatherChunk))});
-        }
-        if (tasks[t].self()) side_b[t] = jobs.size();
-    }
-    task_jobs[tasks.size()] = jobs.size();
     // A spatial order for the big objects read by many pair tasks.
     std::vector<std::uint32_t> pair_tasks(n, 0), to_order;
     for (const TriTask& t : tasks)
@@ -970,6 +949,58 @@ ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
     for (const std::uint32_t o : to_order) orders[o] = spatial_order(objects[o], options.threads);  // parallel inside
     std::vector<std::vector<unsigned char>> in_task(n);
     for (std::uint32_t o = 0; o < n; ++o) in_task[o].assign(objects[o].triangle_boxes.size(), 0);
+
+    // Sweeps slab s of task ti, its refs side a's (the first n0) then side b's, into `o`.
+    const PairTester tester(objects, {});
+    const auto sweep_refs = [&](std::uint32_t ti, int s, const std::vector<TriRef>& refs, std::size_t n0, UnitOut& o) {
+        const TriTask& t = tasks[ti];
+        if (refs.size() < 2) return;
+        if (!t.self() && (n0 == 0 || n0 == refs.size())) return;
+        const std::span<const Aabb> boxes_a = objects[t.a].triangle_boxes;
+        const std::span<const Aabb> boxes_b = objects[t.b].triangle_boxes;
+        sweep_slab(t, s, refs, n0, [&](std::uint32_t pa, std::uint32_t pb) {
+            if (overlaps(boxes_a[pa], boxes_b[pb])) (void)tester.test(t.a, pa, t.b, pb, false, o);
+        });
+    };
+
+    // One job per task plans it (plan_task); a task of one slab (every task of breaking, leaves,
+    // cylinders) is then gathered and swept in the same job, side a then side b into one thread-local
+    // list: no more phases, no copies. Phases cost: each ends with every thread waiting for the last.
+    std::vector<UnitOut> out(tasks.size());
+    parallel_chunks(options.threads, tasks.size(), [&](std::size_t ti) {
+        TriTask& t = tasks[ti];
+        plan_task(t, objects, boxes);
+        if (t.slabs != 1) return;
+        thread_local std::vector<TriRef> refs;
+        refs.clear();
+        gather(t, objects[t.a], boxes[t.a], orders[t.a], 0, static_cast<std::uint32_t>(objects[t.a].triangle_boxes.size()),
+               in_task[t.a], {&refs, 1});
+        const std::size_t n0 = refs.size();
+        if (!t.self())  // even when side a found nothing: side b's in-task flags are counted
+            gather(t, objects[t.b], boxes[t.b], orders[t.b], 0, static_cast<std::uint32_t>(objects[t.b].triangle_boxes.size()),
+                   in_task[t.b], {&refs, 1});
+        sweep_refs(static_cast<std::uint32_t>(ti), 0, refs, n0, out[ti]);
+    });
+
+    // Tasks cut into slabs (a bunny inside a dragon): gather jobs, chunks of each side, side a's then
+    // side b's, then one job per slab.
+    std::vector<GatherJob> jobs;
+    std::vector<std::size_t> task_jobs(tasks.size() + 1, 0);  // jobs of task t: [task_jobs[t], task_jobs[t + 1])
+    std::vector<std::size_t> side_b(tasks.size(), 0);         // its first side-b job
+    for (std::size_t t = 0; t < tasks.size(); ++t) {
+        task_jobs[t] = jobs.size();
+        side_b[t] = jobs.size();
+        if (tasks[t].slabs == 1) continue;
+        for (std::uint32_t side = 0; side < (tasks[t].self() ? 1u : 2u); ++side) {
+            if (side == 1) side_b[t] = jobs.size();
+            const auto count = static_cast<std::uint32_t>(objects[side == 0 ? tasks[t].a : tasks[t].b].triangle_boxes.size());
+            for (std::uint32_t f = 0; f < count; f += kGatherChunk)
+                jobs.push_back({static_cast<std::uint32_t>(t), side, f,
+                                static_cast<std::uint32_t>(std::min<std::size_t>(count, f + kGatherChunk))});
+        }
+        if (tasks[t].self()) side_b[t] = jobs.size();
+    }
+    task_jobs[tasks.size()] = jobs.size();
     std::vector<SlabRefs> gathered(jobs.size());
     parallel_chunks(options.threads, jobs.size(), [&](std::size_t j) {
         const GatherJob& g = jobs[j];
@@ -978,49 +1009,26 @@ ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
         gathered[j].resize(static_cast<std::size_t>(t.slabs));
         gather(t, objects[o], boxes[o], orders[o], g.first, g.last, in_task[o], gathered[j]);
     });
-
-    // Slab jobs.
     struct SlabJob {
         std::uint32_t task;
         int slab;
     };
     std::vector<SlabJob> slabs;
     for (std::size_t t = 0; t < tasks.size(); ++t)
-        for (int s = 0; s < tasks[t].slabs; ++s) slabs.push_back({static_cast<std::uint32_t>(t), s});
-    const PairTester tester(objects, {});
-    std::vector<UnitOut> out(slabs.size());
+        if (tasks[t].slabs > 1)
+            for (int s = 0; s < tasks[t].slabs; ++s) slabs.push_back({static_cast<std::uint32_t>(t), s});
+    out.resize(tasks.size() + slabs.size());
     parallel_chunks(options.threads, slabs.size(), [&](std::size_t sj) {
         const std::uint32_t ti = slabs[sj].task;
-        const TriTask& t = tasks[ti];
         const auto s = static_cast<std::size_t>(slabs[sj].slab);
-        // The slab's refs, side a's then side b's, each in position order (reused by the thread).
         thread_local std::vector<TriRef> refs;
         refs.clear();
-        std::size_t n0 = 0;
-        if (t.slabs == 1) {
-            // One slab: gathered here, one side after the other, the same refs in the same order as
-            // gather jobs would give (no second phase, no copy).
-            gather(t, objects[t.a], boxes[t.a], orders[t.a], 0, static_cast<std::uint32_t>(objects[t.a].triangle_boxes.size()),
-                   in_task[t.a], {&refs, 1});
-            n0 = refs.size();
-            if (!t.self())  // even when side a found nothing: side b's in-task flags are counted
-                gather(t, objects[t.b], boxes[t.b], orders[t.b], 0, static_cast<std::uint32_t>(objects[t.b].triangle_boxes.size()),
-                       in_task[t.b], {&refs, 1});
-        } else {
-            for (std::size_t j = task_jobs[ti]; j < side_b[ti]; ++j)
-                refs.insert(refs.end(), gathered[j][s].begin(), gathered[j][s].end());
-            n0 = refs.size();
-            for (std::size_t j = side_b[ti]; j < task_jobs[ti + 1]; ++j)
-                refs.insert(refs.end(), gathered[j][s].begin(), gathered[j][s].end());
-        }
-        if (refs.size() < 2) return;
-        if (!t.self() && (n0 == 0 || n0 == refs.size())) return;
-        UnitOut& o = out[sj];
-        const std::span<const Aabb> boxes_a = objects[t.a].triangle_boxes;
-        const std::span<const Aabb> boxes_b = objects[t.b].triangle_boxes;
-        sweep_slab(t, slabs[sj].slab, refs, n0, [&](std::uint32_t pa, std::uint32_t pb) {
-            if (overlaps(boxes_a[pa], boxes_b[pb])) (void)tester.test(t.a, pa, t.b, pb, false, o);
-        });
+        for (std::size_t j = task_jobs[ti]; j < side_b[ti]; ++j)
+            refs.insert(refs.end(), gathered[j][s].begin(), gathered[j][s].end());
+        const std::size_t n0 = refs.size();
+        for (std::size_t j = side_b[ti]; j < task_jobs[ti + 1]; ++j)
+            refs.insert(refs.end(), gathered[j][s].begin(), gathered[j][s].end());
+        sweep_refs(ti, slabs[sj].slab, refs, n0, out[tasks.size() + sj]);
     });
     ExactStageResult r = merge(out, false);
     for (std::uint32_t o = 0; o < n; ++o) {
