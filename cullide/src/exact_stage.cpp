@@ -643,29 +643,36 @@ void gather(const TriTask& t, const ExactObject& o, const TriangleBoxes& boxes, 
     const int u = t.gu.axis, v = t.gv.axis;
     const bool spatial = !order.positions.empty();
     const std::span<const Aabb> blocks = spatial ? std::span<const Aabb>(order.blocks) : boxes.blocks;
-    for (std::uint32_t q = first; q < last; ++q) {
-        if (!t.self() && q % kBoxBlock == 0 && !overlaps(blocks[q / kBoxBlock], t.common)) {
-            q += kBoxBlock - 1;  // no triangle of the block meets the common box
-            continue;
+    const bool one_slab = t.slabs == 1;
+    // Block by block (first is a multiple of kBoxBlock): a block whose box misses the common box holds
+    // no triangle meeting it.
+    for (std::uint32_t b0 = first; b0 < last; b0 += static_cast<std::uint32_t>(kBoxBlock)) {
+        if (!t.self() && !overlaps(blocks[b0 / kBoxBlock], t.common)) continue;
+        const std::uint32_t b1 = std::min(last, b0 + static_cast<std::uint32_t>(kBoxBlock));
+        for (std::uint32_t q = b0; q < b1; ++q) {
+            const std::uint32_t p = spatial ? order.positions[q] : q;
+            const FloatBox& fb = boxes.floats[p];
+            if (!t.self()) {
+                // The float box holds the double box: disjoint from the common box (rounded outward),
+                // the double box is too; otherwise the double box decides.
+                if (!float_overlaps(fb, common) || !overlaps(o.triangle_boxes[p], t.common)) continue;
+                std::atomic_ref<unsigned char>(in_task[p]).store(1, std::memory_order_relaxed);
+            }
+            TriRef r;
+            for (int k = 0; k < 3; ++k) {
+                r.lo[k] = fb.lo[k];
+                r.hi[k] = fb.hi[k];
+            }
+            r.pos = p;
+            const std::uint32_t v0 = t.gv.cell(static_cast<double>(r.lo[v]));
+            r.low = t.gu.cell(static_cast<double>(r.lo[u])) | v0 << 16;
+            if (one_slab) {
+                out[0].push_back(r);
+                continue;
+            }
+            const std::uint16_t s1 = t.row_slab[t.gv.cell(static_cast<double>(r.hi[v]))];
+            for (std::uint16_t s = t.row_slab[v0]; s <= s1; ++s) out[s].push_back(r);
         }
-        const std::uint32_t p = spatial ? order.positions[q] : q;
-        const FloatBox& fb = boxes.floats[p];
-        if (!t.self()) {
-            // The float box holds the double box: disjoint from the common box (rounded outward),
-            // the double box is too; otherwise the double box decides.
-            if (!float_overlaps(fb, common) || !overlaps(o.triangle_boxes[p], t.common)) continue;
-            std::atomic_ref<unsigned char>(in_task[p]).store(1, std::memory_order_relaxed);
-        }
-        TriRef r;
-        for (int k = 0; k < 3; ++k) {
-            r.lo[k] = fb.lo[k];
-            r.hi[k] = fb.hi[k];
-        }
-        r.pos = p;
-        const std::uint32_t v0 = t.gv.cell(static_cast<double>(r.lo[v]));
-        r.low = t.gu.cell(static_cast<double>(r.lo[u])) | v0 << 16;
-        const std::uint16_t s1 = t.row_slab[t.gv.cell(static_cast<double>(r.hi[v]))];
-        for (std::uint16_t s = t.row_slab[v0]; s <= s1; ++s) out[s].push_back(r);
     }
 }
 
