@@ -6,6 +6,7 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #if defined(__SSE2__)
@@ -448,7 +449,7 @@ constexpr std::size_t kGatherChunk = 16384;  // triangles per gather job
 constexpr std::size_t kSlabRefs = 8192;      // about this many refs per slab job
 constexpr std::size_t kSpatialMin = 2048;    // an object worth a spatial order: this many triangles
 constexpr std::uint32_t kSpatialTasks = 8;   // in this many pair tasks (tori: 4-5 tasks an object, 12% slower
-                                             // with the order; leaves: 57, 10% faster)
+                                             // with the order), its blocks loose (loose_blocks)
 
 // The refs a gather job found, per slab of its task.
 using SlabRefs = std::vector<std::vector<TriRef>>;
@@ -544,8 +545,8 @@ void plan_task(TriTask& t, std::span<const ExactObject> objects, std::span<const
 // (self: all), into the slabs their rows touch; flags them in `in_task` (pair tasks).
 // An object's triangles in a spatial order (Morton order of their box centres, 4 bits an axis over
 // the object's box) with the box of each block of kBoxBlock of them. For an object in several pair
-// tasks, where the mesh's own order leaves blocks loose: the big object of leaves (about 40 K
-// triangles in 57 tasks, 1,764 of them in any common box) had every task read all its triangles.
+// tasks whose mesh order leaves blocks loose (loose_blocks): a scrambled mesh has every task read
+// all its triangles.
 struct SpatialOrder {
     std::vector<std::uint32_t> positions;  // positions in spatial order; empty: the mesh's order
     std::vector<Aabb> blocks;              // blocks[b]: the box of positions[b * kBoxBlock ...]
@@ -620,36 +621,58 @@ SpatialOrder spatial_order(const ExactObject& o, int threads) {
     return s;
 }
 
+// Whether the mesh's own order leaves an object's blocks loose: their mean size (the sum of a box's
+// three extents) is more than kLooseBlocks of the object's. A mesh made strip by strip or part by
+// part keeps neighbours together (the tree of leaves, 43.6 K triangles in 57 pair tasks: 0.087, and
+// the order cost a third of the frame's instructions for nothing); a scrambled one does not (the same
+// tree shuffled: 0.73, where the order halves the frame). The loosest fragment of breaking (0.34) is
+// about even either way.
+constexpr double kLooseBlocks = 0.4;
+bool loose_blocks(const ExactObject& o, const TriangleBoxes& boxes) {
+    const auto size = [](const Aabb& b) { return (b.hi.x - b.lo.x) + (b.hi.y - b.lo.y) + (b.hi.z - b.lo.z); };
+    double sum = 0.0;
+    for (const Aabb& b : boxes.blocks) sum += size(b);
+    const double whole = size(o.box);
+    return sum > kLooseBlocks * static_cast<double>(boxes.blocks.size()) * whole;
+}
+
 void gather(const TriTask& t, const ExactObject& o, const TriangleBoxes& boxes, const SpatialOrder& order,
-            std::uint32_t first, std::uint32_t last, std::span<unsigned char> in_task, SlabRefs& out) {
-    out.assign(static_cast<std::size_t>(t.slabs), {});
+            std::uint32_t first, std::uint32_t last, std::span<unsigned char> in_task,
+            std::span<std::vector<TriRef>> out) {
     const FloatBox common = float_box(t.common);
     const int u = t.gu.axis, v = t.gv.axis;
     const bool spatial = !order.positions.empty();
     const std::span<const Aabb> blocks = spatial ? std::span<const Aabb>(order.blocks) : boxes.blocks;
-    for (std::uint32_t q = first; q < last; ++q) {
-        if (!t.self() && q % kBoxBlock == 0 && !overlaps(blocks[q / kBoxBlock], t.common)) {
-            q += kBoxBlock - 1;  // no triangle of the block meets the common box
-            continue;
+    const bool one_slab = t.slabs == 1;
+    // Block by block (first is a multiple of kBoxBlock): a block whose box misses the common box holds
+    // no triangle meeting it.
+    for (std::uint32_t b0 = first; b0 < last; b0 += static_cast<std::uint32_t>(kBoxBlock)) {
+        if (!t.self() && !overlaps(blocks[b0 / kBoxBlock], t.common)) continue;
+        const std::uint32_t b1 = std::min(last, b0 + static_cast<std::uint32_t>(kBoxBlock));
+        for (std::uint32_t q = b0; q < b1; ++q) {
+            const std::uint32_t p = spatial ? order.positions[q] : q;
+            const FloatBox& fb = boxes.floats[p];
+            if (!t.self()) {
+                // The float box holds the double box: disjoint from the common box (rounded outward),
+                // the double box is too; otherwise the double box decides.
+                if (!float_overlaps(fb, common) || !overlaps(o.triangle_boxes[p], t.common)) continue;
+                std::atomic_ref<unsigned char>(in_task[p]).store(1, std::memory_order_relaxed);
+            }
+            TriRef r;
+            for (int k = 0; k < 3; ++k) {
+                r.lo[k] = fb.lo[k];
+                r.hi[k] = fb.hi[k];
+            }
+            r.pos = p;
+            const std::uint32_t v0 = t.gv.cell(static_cast<double>(r.lo[v]));
+            r.low = t.gu.cell(static_cast<double>(r.lo[u])) | v0 << 16;
+            if (one_slab) {
+                out[0].push_back(r);
+                continue;
+            }
+            const std::uint16_t s1 = t.row_slab[t.gv.cell(static_cast<double>(r.hi[v]))];
+            for (std::uint16_t s = t.row_slab[v0]; s <= s1; ++s) out[s].push_back(r);
         }
-        const std::uint32_t p = spatial ? order.positions[q] : q;
-        const FloatBox& fb = boxes.floats[p];
-        if (!t.self()) {
-            // The float box holds the double box: disjoint from the common box (rounded outward),
-            // the double box is too; otherwise the double box decides.
-            if (!float_overlaps(fb, common) || !overlaps(o.triangle_boxes[p], t.common)) continue;
-            std::atomic_ref<unsigned char>(in_task[p]).store(1, std::memory_order_relaxed);
-        }
-        TriRef r;
-        for (int k = 0; k < 3; ++k) {
-            r.lo[k] = fb.lo[k];
-            r.hi[k] = fb.hi[k];
-        }
-        r.pos = p;
-        const std::uint32_t v0 = t.gv.cell(static_cast<double>(r.lo[v]));
-        r.low = t.gu.cell(static_cast<double>(r.lo[u])) | v0 << 16;
-        const std::uint16_t s1 = t.row_slab[t.gv.cell(static_cast<double>(r.hi[v]))];
-        for (std::uint16_t s = t.row_slab[v0]; s <= s1; ++s) out[s].push_back(r);
     }
 }
 
@@ -754,6 +777,44 @@ void sweep_slab(const TriTask& t, int s, const std::vector<TriRef>& refs, std::s
             }
         }
     }
+}
+
+// The pairs (i < j) of objects whose non-empty boxes overlap, sorted: a sweep along x over the boxes
+// sorted by their low x. The double loop over every pair was a serial 3% of a leaves frame (151
+// objects, 11 K box tests for 57 overlaps).
+std::vector<std::pair<std::uint32_t, std::uint32_t>> overlapping_objects(std::span<const ExactObject> objects) {
+    std::vector<std::uint32_t> order;
+    order.reserve(objects.size());
+    for (std::uint32_t o = 0; o < objects.size(); ++o)
+        if (!objects[o].box.empty()) order.push_back(o);
+    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+        const double la = objects[a].box.lo.x, lb = objects[b].box.lo.x;
+        return la != lb ? la < lb : a < b;
+    });
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+    for (std::size_t p = 0; p < order.size(); ++p) {
+        const Aabb& a = objects[order[p]].box;
+        // Boxes further on start at or after a's low x: they meet it along x while they start by its high.
+        for (std::size_t q = p + 1; q < order.size() && objects[order[q]].box.lo.x <= a.hi.x; ++q)
+            if (overlaps(a, objects[order[q]].box))
+                pairs.emplace_back(std::min(order[p], order[q]), std::max(order[p], order[q]));
+    }
+    std::sort(pairs.begin(), pairs.end());
+    return pairs;
+}
+
+// The number of set flags (each 0 or 1), eight at a time: the bytes of a word summed by one multiply
+// (the top byte of x * 0x0101010101010101 is the sum of x's bytes, at most 8 here).
+std::uint64_t count_flags(std::span<const unsigned char> flags) {
+    std::uint64_t n = 0;
+    std::size_t i = 0;
+    for (; i + 8 <= flags.size(); i += 8) {
+        std::uint64_t w = 0;
+        std::memcpy(&w, flags.data() + i, 8);
+        n += (w * 0x0101010101010101ULL) >> 56;
+    }
+    for (; i < flags.size(); ++i) n += flags[i];
+    return n;
 }
 
 }  // namespace
@@ -872,29 +933,71 @@ ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
     if (options.self)
         for (std::uint32_t o = 0; o < n; ++o)
             if (objects[o].triangle_boxes.size() >= 2) tasks.push_back({o, o, {}, 0, {}, {}, {}, 1});
-    for (std::uint32_t i = 0; i < n; ++i) {
-        for (std::uint32_t j = i + 1; j < n; ++j) {
-            const Aabb& bi = objects[i].box;
-            const Aabb& bj = objects[j].box;
-            if (bi.empty() || bj.empty() || !overlaps(bi, bj)) continue;
-            TriTask t;
-            t.a = i;
-            t.b = j;
-            for (int k = 0; k < 3; ++k) {
-                t.common.lo[k] = std::max(bi.lo[k], bj.lo[k]);
-                t.common.hi[k] = std::min(bi.hi[k], bj.hi[k]);
-            }
-            tasks.push_back(std::move(t));
+    for (const auto& [i, j] : overlapping_objects(objects)) {
+        const Aabb& bi = objects[i].box;
+        const Aabb& bj = objects[j].box;
+        TriTask t;
+        t.a = i;
+        t.b = j;
+        for (int k = 0; k < 3; ++k) {
+            t.common.lo[k] = std::max(bi.lo[k], bj.lo[k]);
+            t.common.hi[k] = std::min(bi.hi[k], bj.hi[k]);
         }
+        tasks.push_back(std::move(t));
     }
-    parallel_chunks(options.threads, tasks.size(), [&](std::size_t t) { plan_task(tasks[t], objects, boxes); });
+    // A spatial order for the big objects read by many pair tasks.
+    std::vector<std::uint32_t> pair_tasks(n, 0), to_order;
+    for (const TriTask& t : tasks)
+        if (!t.self()) ++pair_tasks[t.a], ++pair_tasks[t.b];
+    for (std::uint32_t o = 0; o < n; ++o)
+        if (pair_tasks[o] >= kSpatialTasks && objects[o].triangle_boxes.size() >= kSpatialMin && loose_blocks(objects[o], boxes[o]))
+            to_order.push_back(o);
+    std::vector<SpatialOrder> orders(n);
+    for (const std::uint32_t o : to_order) orders[o] = spatial_order(objects[o], options.threads);  // parallel inside
+    std::vector<std::vector<unsigned char>> in_task(n);
+    for (std::uint32_t o = 0; o < n; ++o) in_task[o].assign(objects[o].triangle_boxes.size(), 0);
 
-    // Gather jobs: chunks of each side of each task, side a's then side b's.
+    // Sweeps slab s of task ti, its refs side a's (the first n0) then side b's, into `o`.
+    const PairTester tester(objects, {});
+    const auto sweep_refs = [&](std::uint32_t ti, int s, const std::vector<TriRef>& refs, std::size_t n0, UnitOut& o) {
+        const TriTask& t = tasks[ti];
+        if (refs.size() < 2) return;
+        if (!t.self() && (n0 == 0 || n0 == refs.size())) return;
+        const std::span<const Aabb> boxes_a = objects[t.a].triangle_boxes;
+        const std::span<const Aabb> boxes_b = objects[t.b].triangle_boxes;
+        sweep_slab(t, s, refs, n0, [&](std::uint32_t pa, std::uint32_t pb) {
+            if (overlaps(boxes_a[pa], boxes_b[pb])) (void)tester.test(t.a, pa, t.b, pb, false, o);
+        });
+    };
+
+    // One job per task plans it (plan_task); a task of one slab (every task of breaking, leaves,
+    // cylinders) is then gathered and swept in the same job, side a then side b into one thread-local
+    // list: no more phases, no copies. Phases cost: each ends with every thread waiting for the last.
+    std::vector<UnitOut> out(tasks.size());
+    parallel_chunks(options.threads, tasks.size(), [&](std::size_t ti) {
+        TriTask& t = tasks[ti];
+        plan_task(t, objects, boxes);
+        if (t.slabs != 1) return;
+        thread_local std::vector<TriRef> refs;
+        refs.clear();
+        gather(t, objects[t.a], boxes[t.a], orders[t.a], 0, static_cast<std::uint32_t>(objects[t.a].triangle_boxes.size()),
+               in_task[t.a], {&refs, 1});
+        const std::size_t n0 = refs.size();
+        if (!t.self())  // even when side a found nothing: side b's in-task flags are counted
+            gather(t, objects[t.b], boxes[t.b], orders[t.b], 0, static_cast<std::uint32_t>(objects[t.b].triangle_boxes.size()),
+                   in_task[t.b], {&refs, 1});
+        sweep_refs(static_cast<std::uint32_t>(ti), 0, refs, n0, out[ti]);
+    });
+
+    // Tasks cut into slabs (a bunny inside a dragon): gather jobs, chunks of each side, side a's then
+    // side b's, then one job per slab.
     std::vector<GatherJob> jobs;
     std::vector<std::size_t> task_jobs(tasks.size() + 1, 0);  // jobs of task t: [task_jobs[t], task_jobs[t + 1])
     std::vector<std::size_t> side_b(tasks.size(), 0);         // its first side-b job
     for (std::size_t t = 0; t < tasks.size(); ++t) {
         task_jobs[t] = jobs.size();
+        side_b[t] = jobs.size();
+        if (tasks[t].slabs == 1) continue;
         for (std::uint32_t side = 0; side < (tasks[t].self() ? 1u : 2u); ++side) {
             if (side == 1) side_b[t] = jobs.size();
             const auto count = static_cast<std::uint32_t>(objects[side == 0 ? tasks[t].a : tasks[t].b].triangle_boxes.size());
@@ -905,55 +1008,34 @@ ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
         if (tasks[t].self()) side_b[t] = jobs.size();
     }
     task_jobs[tasks.size()] = jobs.size();
-    // A spatial order for the big objects read by many pair tasks.
-    std::vector<std::uint32_t> pair_tasks(n, 0), to_order;
-    for (const TriTask& t : tasks)
-        if (!t.self()) ++pair_tasks[t.a], ++pair_tasks[t.b];
-    for (std::uint32_t o = 0; o < n; ++o)
-        if (pair_tasks[o] >= kSpatialTasks && objects[o].triangle_boxes.size() >= kSpatialMin) to_order.push_back(o);
-    std::vector<SpatialOrder> orders(n);
-    for (const std::uint32_t o : to_order) orders[o] = spatial_order(objects[o], options.threads);  // parallel inside
-    std::vector<std::vector<unsigned char>> in_task(n);
-    for (std::uint32_t o = 0; o < n; ++o) in_task[o].assign(objects[o].triangle_boxes.size(), 0);
     std::vector<SlabRefs> gathered(jobs.size());
     parallel_chunks(options.threads, jobs.size(), [&](std::size_t j) {
         const GatherJob& g = jobs[j];
         const TriTask& t = tasks[g.task];
         const std::uint32_t o = g.side == 0 ? t.a : t.b;
+        gathered[j].resize(static_cast<std::size_t>(t.slabs));
         gather(t, objects[o], boxes[o], orders[o], g.first, g.last, in_task[o], gathered[j]);
     });
-
-    // Slab jobs.
     struct SlabJob {
         std::uint32_t task;
         int slab;
     };
     std::vector<SlabJob> slabs;
     for (std::size_t t = 0; t < tasks.size(); ++t)
-        for (int s = 0; s < tasks[t].slabs; ++s) slabs.push_back({static_cast<std::uint32_t>(t), s});
-    const PairTester tester(objects, {});
-    std::vector<UnitOut> out(slabs.size());
+        if (tasks[t].slabs > 1)
+            for (int s = 0; s < tasks[t].slabs; ++s) slabs.push_back({static_cast<std::uint32_t>(t), s});
+    out.resize(tasks.size() + slabs.size());
     parallel_chunks(options.threads, slabs.size(), [&](std::size_t sj) {
         const std::uint32_t ti = slabs[sj].task;
-        const TriTask& t = tasks[ti];
         const auto s = static_cast<std::size_t>(slabs[sj].slab);
-        std::size_t total = 0;
-        for (std::size_t j = task_jobs[ti]; j < task_jobs[ti + 1]; ++j) total += gathered[j][s].size();
-        if (total < 2) return;
-        std::vector<TriRef> refs;
-        refs.reserve(total);
+        thread_local std::vector<TriRef> refs;
+        refs.clear();
         for (std::size_t j = task_jobs[ti]; j < side_b[ti]; ++j)
             refs.insert(refs.end(), gathered[j][s].begin(), gathered[j][s].end());
         const std::size_t n0 = refs.size();
         for (std::size_t j = side_b[ti]; j < task_jobs[ti + 1]; ++j)
             refs.insert(refs.end(), gathered[j][s].begin(), gathered[j][s].end());
-        if (!t.self() && (n0 == 0 || n0 == refs.size())) return;
-        UnitOut& o = out[sj];
-        const std::span<const Aabb> boxes_a = objects[t.a].triangle_boxes;
-        const std::span<const Aabb> boxes_b = objects[t.b].triangle_boxes;
-        sweep_slab(t, slabs[sj].slab, refs, n0, [&](std::uint32_t pa, std::uint32_t pb) {
-            if (overlaps(boxes_a[pa], boxes_b[pb])) (void)tester.test(t.a, pa, t.b, pb, false, o);
-        });
+        sweep_refs(ti, slabs[sj].slab, refs, n0, out[tasks.size() + sj]);
     });
     ExactStageResult r = merge(out, false);
     for (std::uint32_t o = 0; o < n; ++o) {
@@ -961,7 +1043,7 @@ ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
             r.stats.task_triangles += objects[o].triangle_boxes.size();
             continue;
         }
-        for (const unsigned char f : in_task[o]) r.stats.task_triangles += f;
+        r.stats.task_triangles += count_flags(in_task[o]);
     }
     return r;
 }

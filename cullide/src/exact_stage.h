@@ -102,18 +102,15 @@ struct FloatBox {
     return f;
 }
 
-// float_box of the box [lo, hi], every bound as float_down / float_up give it (the same bits; x86-64:
-// four bounds per SSE2 step, the same round-to-nearest conversion and one-step correction). The
-// ground truth's scan rounds every triangle's box, 6 bounds each: scalar, that was a quarter of its
-// time on breaking and leaves.
-[[nodiscard]] inline FloatBox float_box(const Vec3& lo, const Vec3& hi) {
-    FloatBox f;
 #if defined(__SSE2__)
-    // The six float_down arguments lo.x, lo.y, lo.z, -hi.x | -hi.y, -hi.z (float_up(x) = -float_down(-x)).
+// float_box of the box whose lows are (lo_xy, lo_z) and highs (hi_xy, hi_z), x and y in the two
+// lanes, z in the low lane: the scan hands its SSE2 registers over as they are.
+[[nodiscard]] inline FloatBox float_box_sse2(__m128d lo_xy, __m128d lo_z, __m128d hi_xy, __m128d hi_z) {
+    // The six float_down arguments lo.x, lo.y | lo.z, -hi.x | -hi.y, -hi.z (float_up(x) = -float_down(-x)).
     constexpr double kMax = static_cast<double>(std::numeric_limits<float>::max());
     const __m128d neg = _mm_set1_pd(-0.0);
-    const __m128d x0 = _mm_set_pd(lo.y, lo.x), x1 = _mm_xor_pd(_mm_set_pd(hi.x, lo.z), _mm_set_pd(-0.0, 0.0));
-    const __m128d x2 = _mm_xor_pd(_mm_set_pd(hi.z, hi.y), neg);
+    const __m128d nhi_xy = _mm_xor_pd(hi_xy, neg), nhi_z = _mm_xor_pd(hi_z, neg);
+    const __m128d x0 = lo_xy, x1 = _mm_unpacklo_pd(lo_z, nhi_xy), x2 = _mm_shuffle_pd(nhi_xy, nhi_z, 1);
     const auto down4 = [&](__m128d a, __m128d b) {
         const __m128d ca = _mm_min_pd(_mm_max_pd(a, _mm_set1_pd(-kMax)), _mm_set1_pd(kMax));
         const __m128d cb = _mm_min_pd(_mm_max_pd(b, _mm_set1_pd(-kMax)), _mm_set1_pd(kMax));
@@ -132,19 +129,32 @@ struct FloatBox {
     alignas(16) float d[8];
     _mm_store_ps(d, down4(x0, x1));
     _mm_store_ps(d + 4, down4(x2, x2));
+    FloatBox f;
     f.lo[0] = d[0];
     f.lo[1] = d[1];
     f.lo[2] = d[2];
     f.hi[0] = -d[3];
     f.hi[1] = -d[4];
     f.hi[2] = -d[5];
+    return f;
+}
+#endif
+
+// float_box of the box [lo, hi], every bound as float_down / float_up give it (the same bits; x86-64:
+// four bounds per SSE2 step, the same round-to-nearest conversion and one-step correction). The
+// ground truth's scan rounds every triangle's box, 6 bounds each: scalar, that was a quarter of its
+// time on breaking and leaves.
+[[nodiscard]] inline FloatBox float_box(const Vec3& lo, const Vec3& hi) {
+#if defined(__SSE2__)
+    return float_box_sse2(_mm_set_pd(lo.y, lo.x), _mm_set_sd(lo.z), _mm_set_pd(hi.y, hi.x), _mm_set_sd(hi.z));
 #else
+    FloatBox f;
     for (int k = 0; k < 3; ++k) {
         f.lo[k] = float_down(lo[k]);
         f.hi[k] = float_up(hi[k]);
     }
-#endif
     return f;
+#endif
 }
 
 [[nodiscard]] inline bool float_overlaps(const FloatBox& a, const FloatBox& b) {

@@ -1,12 +1,19 @@
 #include "cullide/ground_truth.h"
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <limits>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <numeric>
 #include <string>
 #include <type_traits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "cullide/predicates.h"
 #include "exact_stage.h"
@@ -78,6 +85,31 @@ Status validate_exact_range(std::span<const Mesh> objects) {
 
 namespace {
 
+// 1 when x is outside the exact range, else 0: !predicate_coordinate_ok(x) on the bits. |x|'s bits
+// as an integer grow with |x| (infinities and NaNs above every finite value), so the range is one
+// unsigned compare, and 0 the one exception. Comparisons of doubles branched on every coordinate of
+// the scan's vertex jobs.
+constexpr unsigned coordinate_bad(double x) {
+    constexpr std::uint64_t kLo = std::bit_cast<std::uint64_t>(kPredicateMinAbs);
+    constexpr std::uint64_t kHi = std::bit_cast<std::uint64_t>(kPredicateMaxAbs);
+    const std::uint64_t m = std::bit_cast<std::uint64_t>(x) & 0x7fffffffffffffffULL;
+    return static_cast<unsigned>(m - kLo > kHi - kLo) & static_cast<unsigned>(m != 0);
+}
+constexpr bool same_as_predicate(double x) { return coordinate_bad(x) == (predicate_coordinate_ok(x) ? 0u : 1u); }
+static_assert(same_as_predicate(0.0) && same_as_predicate(-0.0) && same_as_predicate(1.0) && same_as_predicate(-3.5e7));
+static_assert(same_as_predicate(kPredicateMinAbs) && same_as_predicate(-kPredicateMinAbs) &&
+              same_as_predicate(kPredicateMaxAbs) && same_as_predicate(-kPredicateMaxAbs));
+constexpr double step_bits(double x, std::int64_t by) {  // by floats in x's magnitude, for the checks
+    return std::bit_cast<double>(std::bit_cast<std::uint64_t>(x) + static_cast<std::uint64_t>(by));
+}
+static_assert(same_as_predicate(step_bits(kPredicateMinAbs, -1)) && same_as_predicate(step_bits(kPredicateMaxAbs, 1)) &&
+              same_as_predicate(step_bits(-kPredicateMinAbs, -1)) && same_as_predicate(step_bits(-kPredicateMaxAbs, 1)) &&
+              same_as_predicate(0x1p-1074) && same_as_predicate(-0x1p-1074) && same_as_predicate(1e308));
+static_assert(same_as_predicate(std::numeric_limits<double>::infinity()) &&
+              same_as_predicate(-std::numeric_limits<double>::infinity()) &&
+              same_as_predicate(std::numeric_limits<double>::quiet_NaN()) &&
+              same_as_predicate(-std::numeric_limits<double>::quiet_NaN()));
+
 // One job of exact_pairs' first pass: triangles [first, last) of an object (indices in range, and
 // their boxes) or its positions [first, last) (coordinates in the exact range).
 struct ScanJob {
@@ -85,7 +117,12 @@ struct ScanJob {
     bool positions = false;
     std::size_t first = 0, last = 0;
 };
-constexpr std::size_t kScanChunk = 16384;  // a multiple of detail::kBoxBlock
+// A multiple of detail::kBoxBlock. Small enough that a big object makes many jobs: oneTBB splits the
+// job list in halves and a thread that runs dry steals whole jobs, so the tree of leaves' 3 triangle
+// jobs of 16 K and 2 vertex jobs, first in the list, kept the first thread busy while the second
+// finished the 300 small ones (a model of that list, 5 big jobs then 300 small, on a 2-thread
+// arena: 1202 units on the caller, 598 on the worker; as 17 jobs a third the size: 980 and 810).
+constexpr std::size_t kScanChunk = 4096;
 
 // An array the scan jobs construct in place: std::vector's resize would first write every element,
 // on one thread (12 MB on bunny-dragon). Only trivially destructible elements, each constructed by a
@@ -147,9 +184,7 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
                 unsigned bad = 0;
                 for (std::size_t v = job.first; v < job.last; ++v) {
                     const Vec3 p = m.positions[v];
-                    bad |= static_cast<unsigned>(!predicate_coordinate_ok(p.x)) |
-                           static_cast<unsigned>(!predicate_coordinate_ok(p.y)) |
-                           static_cast<unsigned>(!predicate_coordinate_ok(p.z));
+                    bad |= coordinate_bad(p.x) | coordinate_bad(p.y) | coordinate_bad(p.z);
                 }
                 if (bad != 0) job_ok[j] = 0;
                 return;
@@ -159,31 +194,78 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
             detail::FloatBox* const float_out = floats.data() + first_triangle[job.object];
             Aabb* const block_out = blocks.data() + first_block[job.object];
             Aabb all{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
+            const Vec3* const pos = m.positions.data();
+            const Tri* const tris = m.triangles.data();
             for (std::size_t b0 = job.first; b0 < job.last; b0 += detail::kBoxBlock) {
-                Aabb block = all;
                 const std::size_t b1 = std::min(job.last, b0 + detail::kBoxBlock);
+#if defined(__SSE2__)
+                // x and y in the two lanes of one register, z alone. std::min(a, b) is (b < a ? b : a),
+                // which is _mm_min_pd(b, a) (MINPD returns its second operand on ties, so signed zeros
+                // keep the scalar code's choice); std::max(a, b) is _mm_max_pd(b, a) likewise.
+                __m128d blo_xy = _mm_set1_pd(HUGE_VAL), blo_z = blo_xy, bhi_xy = _mm_set1_pd(-HUGE_VAL), bhi_z = bhi_xy;
                 for (std::size_t t = b0; t < b1; ++t) {
-                    const Tri& tri = m.triangles[t];
+                    const Tri tri = tris[t];
                     if (tri[0] >= count || tri[1] >= count || tri[2] >= count) {
                         job_ok[j] = 0;
                         return;
                     }
-                    const Vec3 a = m.positions[tri[0]];
-                    const Vec3 b = m.positions[tri[1]];
-                    const Vec3 c = m.positions[tri[2]];
-                    // Component by component (Vec3's operator[] branches on the index).
-                    const Vec3 lo{std::min({a.x, b.x, c.x}), std::min({a.y, b.y, c.y}), std::min({a.z, b.z, c.z})};
-                    const Vec3 hi{std::max({a.x, b.x, c.x}), std::max({a.y, b.y, c.y}), std::max({a.z, b.z, c.z})};
-                    block.lo = {std::min(block.lo.x, lo.x), std::min(block.lo.y, lo.y), std::min(block.lo.z, lo.z)};
-                    block.hi = {std::max(block.hi.x, hi.x), std::max(block.hi.y, hi.y), std::max(block.hi.z, hi.z)};
+                    const double* const a = &pos[tri[0]].x;
+                    const double* const b = &pos[tri[1]].x;
+                    const double* const c = &pos[tri[2]].x;
+                    const __m128d a_xy = _mm_loadu_pd(a), b_xy = _mm_loadu_pd(b), c_xy = _mm_loadu_pd(c);
+                    const __m128d a_z = _mm_load_sd(a + 2), b_z = _mm_load_sd(b + 2), c_z = _mm_load_sd(c + 2);
+                    const __m128d lo_xy = _mm_min_pd(c_xy, _mm_min_pd(b_xy, a_xy));
+                    const __m128d lo_z = _mm_min_sd(c_z, _mm_min_sd(b_z, a_z));
+                    const __m128d hi_xy = _mm_max_pd(c_xy, _mm_max_pd(b_xy, a_xy));
+                    const __m128d hi_z = _mm_max_sd(c_z, _mm_max_sd(b_z, a_z));
+                    blo_xy = _mm_min_pd(lo_xy, blo_xy);
+                    blo_z = _mm_min_sd(lo_z, blo_z);
+                    bhi_xy = _mm_max_pd(hi_xy, bhi_xy);
+                    bhi_z = _mm_max_sd(hi_z, bhi_z);
+                    Aabb box;
+                    _mm_storeu_pd(&box.lo.x, lo_xy);
+                    _mm_store_sd(&box.lo.z, lo_z);
+                    _mm_storeu_pd(&box.hi.x, hi_xy);
+                    _mm_store_sd(&box.hi.z, hi_z);
+                    std::construct_at(box_out + t, box);
+                    std::construct_at(float_out + t, detail::float_box_sse2(lo_xy, lo_z, hi_xy, hi_z));
+                }
+                Aabb block;
+                _mm_storeu_pd(&block.lo.x, blo_xy);
+                _mm_store_sd(&block.lo.z, blo_z);
+                _mm_storeu_pd(&block.hi.x, bhi_xy);
+                _mm_store_sd(&block.hi.z, bhi_z);
+#else
+                double bx0 = HUGE_VAL, by0 = HUGE_VAL, bz0 = HUGE_VAL, bx1 = -HUGE_VAL, by1 = -HUGE_VAL, bz1 = -HUGE_VAL;
+                for (std::size_t t = b0; t < b1; ++t) {
+                    const Tri tri = tris[t];
+                    if (tri[0] >= count || tri[1] >= count || tri[2] >= count) {
+                        job_ok[j] = 0;
+                        return;
+                    }
+                    const Vec3 a = pos[tri[0]];
+                    const Vec3 b = pos[tri[1]];
+                    const Vec3 c = pos[tri[2]];
+                    // Component by component (Vec3's operator[] branches on the index); the first of
+                    // equal values wins, as std::min({a, b, c}) picks it (signed zeros keep their sign).
+                    const Vec3 lo{std::min(std::min(a.x, b.x), c.x), std::min(std::min(a.y, b.y), c.y),
+                                  std::min(std::min(a.z, b.z), c.z)};
+                    const Vec3 hi{std::max(std::max(a.x, b.x), c.x), std::max(std::max(a.y, b.y), c.y),
+                                  std::max(std::max(a.z, b.z), c.z)};
+                    bx0 = std::min(bx0, lo.x);
+                    by0 = std::min(by0, lo.y);
+                    bz0 = std::min(bz0, lo.z);
+                    bx1 = std::max(bx1, hi.x);
+                    by1 = std::max(by1, hi.y);
+                    bz1 = std::max(bz1, hi.z);
                     std::construct_at(box_out + t, Aabb{lo, hi});
                     std::construct_at(float_out + t, detail::float_box(lo, hi));
                 }
+                const Aabb block{{bx0, by0, bz0}, {bx1, by1, bz1}};
+#endif
                 std::construct_at(block_out + b0 / detail::kBoxBlock, block);
-                for (int k = 0; k < 3; ++k) {
-                    all.lo[k] = std::min(all.lo[k], block.lo[k]);
-                    all.hi[k] = std::max(all.hi[k], block.hi[k]);
-                }
+                all.lo = {std::min(all.lo.x, block.lo.x), std::min(all.lo.y, block.lo.y), std::min(all.lo.z, block.lo.z)};
+                all.hi = {std::max(all.hi.x, block.hi.x), std::max(all.hi.y, block.hi.y), std::max(all.hi.z, block.hi.z)};
             }
             job_box[j] = all;
         });

@@ -40,7 +40,7 @@ enum class Method {
 // Method::Auto's estimate for one frame (plan_auto): the exact stage's work, counted as the
 // triangles its object-pair tasks would hold (each object's triangles times the share of its box
 // that the pair's common box covers, per axis, summed over the overlapping object pairs; boxes of
-// the vertex lists, read in one linear pass), against
+// the vertex lists, read in linear passes), against
 // the triangles a round of three R-CULLIDE views would rasterize. Deterministic: counts and box
 // extents only, so the choice is the same for any thread count and machine.
 struct AutoPlan {
@@ -65,6 +65,8 @@ inline constexpr std::uint64_t kAutoMinViewTriangles = 4096;
 // an index, so it is safe on meshes not yet checked (process_frame plans an `auto` frame before
 // exact_pairs checks the scene; an invalid scene's plan is meaningless, and the frame fails).
 [[nodiscard]] AutoPlan plan_auto(std::span<const Mesh> objects, std::span<const std::uint32_t> active);
+// The same, on `threads` workers (the same rule as RunOptions::threads); the same plan for any count.
+[[nodiscard]] AutoPlan plan_auto(std::span<const Mesh> objects, std::span<const std::uint32_t> active, int threads);
 
 // The optional first stage, on the objects' axis-aligned boxes (spatialhash/broad_phase.h).
 enum class BroadPhase { None, SpatialHash, SweepAndPrune, BruteForce };
