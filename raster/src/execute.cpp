@@ -372,7 +372,12 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
                 continue;
             if (c.state.depth_write) wrote = true;
             const auto& tri = ctx.setup.tris[ctx.setup.src[r.draw]][r.tri];
-            const detail::PixelRect rect = clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1);
+            detail::PixelRect rect = clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1);
+            // A triangle over several tiles: its part of this tile may be much smaller than the
+            // box's (a thin triangle through a corner). Within one tile the box is already tight.
+            if ((rect.x0 != tri.x0 || rect.y0 != tri.y0 || rect.x1 != tri.x1 || rect.y1 != tri.y1) &&
+                !detail::shrink_rect(tri, rect))
+                continue;
             passed = hiz != nullptr ? detail::raster_rect_hiz(tri, depth_state, ctx.depth, rect, *hiz, ctx.allow_simd, any_only)
                              : detail::raster_rect(tri, depth_state, ctx.depth, rect, ctx.allow_simd, any_only);
             if (any_only && passed != 0) ctx.answered[q].store(true, std::memory_order_relaxed);

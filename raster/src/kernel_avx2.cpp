@@ -6,7 +6,8 @@
 // Layout: 8x1 pixels per step along a row. Coverage stays exact integer arithmetic on the same
 // 16.8 edge functions (same snapping, same fill-rule bias folded into c): narrow rectangles test
 // 8 pixels at once in 32-bit lanes when a bound proves no value overflows; wider ones solve each
-// row's covered span with the scalar code (edge_span of raster_kernel.inc, 64-bit floor divisions).
+// row's covered span from the 64-bit edge functions: the scalar code's floor divisions (edge_span
+// of raster_kernel.inc), done once per rectangle and then stepped row to row (EdgeWalk).
 // Either way the covered set is the scalar path's. The vector part is depth; per 8 pixels:
 //   z = fma(dzdy, y, fma(dzdx, x, z0))   (_mm256_fmadd_ps: one correctly rounded fma, as std::fma)
 //   clamp: max(z, 0) then min(z, 1)      (maxps returns its second operand when z is NaN: NaN -> 0,
@@ -123,6 +124,29 @@ inline unsigned chunk8(const SetupTri& t, std::uint32_t* row, int px, __m256 fy,
     return bits;
 }
 
+// floor(n(py) / d) for successive rows py, n(py) = n(y0) + step * (py - y0), d > 0: quotient and
+// remainder stepped by the step's own quotient and remainder (the integer walk of Bresenham's
+// line algorithm), so a row costs adds and one compare instead of a 64-bit division; the same
+// integers as floor_div on every row.
+struct EdgeWalk {
+    std::int64_t q, r, dq, dr, d;  // n = q d + r, 0 <= r < d; step = dq d + dr, 0 <= dr < d
+    void init(std::int64_t n, std::int64_t step, std::int64_t div) {
+        d = div;
+        q = avx2::floor_div(n, d);
+        r = n - q * d;
+        dq = avx2::floor_div(step, d);
+        dr = step - dq * d;
+    }
+    void next() {
+        q += dq;
+        r += dr;
+        if (r >= d) {
+            r -= d;
+            ++q;
+        }
+    }
+};
+
 constexpr int kNarrow = 16;  // rectangles narrower than this take the per-chunk edge path when it fits
 
 template <DepthFormat Fmt, DepthFunc F, bool Write>
@@ -200,13 +224,41 @@ std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, b
         if (!(e00 > 0 && e10 > 0 && e01 > 0 && e11 > 0)) edges[n_edges++] = i;  // else trivially inside
     }
 
-    // Otherwise each row's span from the 64-bit edge functions (the scalar solver).
+    // Otherwise each row's span from the 64-bit edge functions: the scalar solver's floor
+    // divisions (edge_span of raster_kernel.inc), stepped from row to row without dividing
+    // (EdgeWalk). An edge constant along rows (dcdx = 0) bounds the rows instead, exactly.
+    EdgeWalk upper[3], lower[3];  // bounds on the last / first covered column
+    int n_upper = 0, n_lower = 0;
+    int y0 = ry0, y1 = ry1;
+    for (int k = 0; k < n_edges; ++k) {
+        const int i = edges[k];
+        const std::int64_t s = t.dcdx[i] * 256, sy = t.dcdy[i] * 256;
+        if (s != 0) continue;
+        if (sy > 0) {
+            y0 = static_cast<int>(std::max<std::int64_t>(y0, avx2::floor_div(-t.c[i], sy) + 1));
+        } else if (sy < 0) {
+            y1 = static_cast<int>(std::min<std::int64_t>(y1, avx2::floor_div(t.c[i] - 1, -sy)));
+        } else if (t.c[i] <= 0) {
+            return 0;
+        }
+    }
+    for (int k = 0; k < n_edges; ++k) {
+        const int i = edges[k];
+        const std::int64_t s = t.dcdx[i] * 256, sy = t.dcdy[i] * 256;
+        const std::int64_t base = t.c[i] + sy * y0;  // e(px) = base - s px on the row y0
+        if (s > 0) upper[n_upper++].init(base - 1, sy, s);  // px <= floor((base - 1) / s)
+        if (s < 0) lower[n_lower++].init(-base, -sy, -s);   // px >= floor(-base / -s) + 1
+    }
     const __m256i all = _mm256_set1_epi32(-1);
-    for (int py = ry0; py <= ry1; ++py) {
+    for (int py = y0; py <= y1; ++py) {
         std::int64_t lo = rx0, hi = rx1;
-        for (int k = 0; k < n_edges; ++k) {
-            const int i = edges[k];
-            avx2::edge_span(t.c[i] + t.dcdy[i] * 256 * py, t.dcdx[i], lo, hi);
+        for (int k = 0; k < n_upper; ++k) {
+            hi = std::min(hi, upper[k].q);
+            upper[k].next();
+        }
+        for (int k = 0; k < n_lower; ++k) {
+            lo = std::max(lo, lower[k].q + 1);
+            lower[k].next();
         }
         if (lo > hi) continue;
         std::uint32_t* row = depth.row(py);
