@@ -69,15 +69,15 @@ inline __m256i pass8(__m256i incoming, __m256i stored) {
         if constexpr (F == DepthFunc::NotEqual) return _mm256_castps_si256(_mm256_cmp_ps(a, b, _CMP_NEQ_UQ));
         if constexpr (F == DepthFunc::GEqual) return _mm256_castps_si256(_mm256_cmp_ps(a, b, _CMP_GE_OQ));
     } else {
-        // Unsigned 32-bit order through a sign flip and the signed compare.
-        const __m256i bias = _mm256_set1_epi32(static_cast<int>(0x80000000u));
-        const __m256i a = _mm256_xor_si256(incoming, bias), b = _mm256_xor_si256(stored, bias);
-        if constexpr (F == DepthFunc::Less) return _mm256_cmpgt_epi32(b, a);
+        // Unsigned 32-bit order: a <= b exactly when the unsigned maximum of the two is b (two
+        // instructions; a sign flip of both and the signed compare took three or four).
+        const __m256i a = incoming, b = stored, top = _mm256_max_epu32(a, b);
+        if constexpr (F == DepthFunc::Less) return _mm256_xor_si256(_mm256_cmpeq_epi32(top, a), ones);
         if constexpr (F == DepthFunc::Equal) return _mm256_cmpeq_epi32(a, b);
-        if constexpr (F == DepthFunc::LEqual) return _mm256_xor_si256(_mm256_cmpgt_epi32(a, b), ones);
-        if constexpr (F == DepthFunc::Greater) return _mm256_cmpgt_epi32(a, b);
+        if constexpr (F == DepthFunc::LEqual) return _mm256_cmpeq_epi32(top, b);
+        if constexpr (F == DepthFunc::Greater) return _mm256_xor_si256(_mm256_cmpeq_epi32(top, b), ones);
         if constexpr (F == DepthFunc::NotEqual) return _mm256_xor_si256(_mm256_cmpeq_epi32(a, b), ones);
-        if constexpr (F == DepthFunc::GEqual) return _mm256_xor_si256(_mm256_cmpgt_epi32(b, a), ones);
+        if constexpr (F == DepthFunc::GEqual) return _mm256_cmpeq_epi32(top, a);
     }
     return _mm256_setzero_si256();
 }
@@ -91,20 +91,31 @@ inline std::int64_t edge_at(const SetupTri& t, int i, int px, int py) {
     return t.c[i] - t.dcdx[i] * 256 * px + t.dcdy[i] * 256 * py;
 }
 
-// Depth test (and write) of the 8 pixels px..px+7 of `row` at row centre fy; `cover` marks the
-// pixels to process (full: all 8, plain load and blended store). Returns the passing-lane bits.
-// The inner fma of the depth plane for the 8 pixels px..px+7: fma(dzdx, x, z0), the same in every row.
-inline __m256 plane_x8(const SetupTri& t, int px) {
+// The depth plane's coefficients in every lane, read from the SetupTri once per rectangle (a
+// store through __m256i may alias anything, so loops that read them from `t` reload them after
+// every store).
+struct Plane8 {
+    __m256 z0, dzdx, dzdy;
+    explicit Plane8(const SetupTri& t)
+        : z0(_mm256_set1_ps(t.z0)), dzdx(_mm256_set1_ps(t.dzdx)), dzdy(_mm256_set1_ps(t.dzdy)) {}
+};
+
+// The x coordinates px..px+7 as floats (exact: |px| < 2^24).
+inline __m256 lane_x8(int px) {
     const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-    const __m256 fx = _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(px), iota));
-    return _mm256_fmadd_ps(_mm256_set1_ps(t.dzdx), fx, _mm256_set1_ps(t.z0));
+    return _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(px), iota));
 }
 
-// zx: plane_x8(t, px), computed once per column of chunks by callers that visit it in many rows.
+// The inner fma of the depth plane for the 8 pixels at x = fx: fma(dzdx, x, z0), the same in every row.
+inline __m256 plane_x8(const Plane8& p, __m256 fx) { return _mm256_fmadd_ps(p.dzdx, fx, p.z0); }
+
+// Depth test (and write) of the 8 pixels px..px+7 of `row` at row centre fy; `cover` marks the
+// pixels to process (full: all 8, plain load and blended store). Returns the passing-lane bits.
+// zx: plane_x8 of the 8 pixels, computed once per column of chunks by callers that visit it in many rows.
 template <DepthFormat Fmt, DepthFunc F, bool Write>
-inline unsigned chunk8(const SetupTri& t, std::uint32_t* row, int px, __m256 fy, __m256i cover, bool full,
+inline unsigned chunk8(const Plane8& plane, std::uint32_t* row, int px, __m256 fy, __m256i cover, bool full,
                        __m256 zx) {
-    __m256 z = _mm256_fmadd_ps(_mm256_set1_ps(t.dzdy), fy, zx);
+    __m256 z = _mm256_fmadd_ps(plane.dzdy, fy, zx);
     z = _mm256_max_ps(z, _mm256_setzero_ps());
     z = _mm256_min_ps(z, _mm256_set1_ps(1.0f));
     const __m256i incoming = encode8<Fmt>(z);
@@ -149,6 +160,56 @@ struct EdgeWalk {
 
 constexpr int kNarrow = 16;  // rectangles narrower than this take the per-chunk edge path when it fits
 
+// The narrow path of raster_rect8 (below) for a rectangle of `Columns` chunks of 8 pixels (1 or
+// 2), given each edge's value at (rx0, ry0) and its x and y steps, all known to fit in 32 bits over
+// the rectangle padded to whole chunks. Per column, set up once: the lanes' edge values in the
+// first row (stepped by the y steps per row, every value an edge value of a pixel of the padded
+// rectangle, so within the bound), the in-rectangle lanes and the inner fma of the depth plane.
+// The column count is a constant so that the edge vectors stay in registers across rows.
+template <int Columns, DepthFormat Fmt, DepthFunc F, bool Write>
+std::uint64_t narrow_rows(const SetupTri& t, DepthRows depth, PixelRect rect, const std::int64_t (&e_row)[3],
+                          const std::int64_t (&sx)[3], const std::int64_t (&sy)[3], bool stop_at_first) {
+    const int rx0 = rect.x0, ry0 = rect.y0, rx1 = rect.x1, ry1 = rect.y1;
+    const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const Plane8 plane(t);
+    __m256i e[Columns][3], in_rect[Columns], step_y[3];
+    __m256 zx[Columns];
+    #pragma GCC unroll 3
+    for (int i = 0; i < 3; ++i) step_y[i] = _mm256_set1_epi32(static_cast<std::int32_t>(sy[i]));
+    #pragma GCC unroll 2
+    for (int k = 0; k < Columns; ++k) {
+        const int px = rx0 + 8 * k;
+        in_rect[k] = _mm256_cmpgt_epi32(_mm256_set1_epi32(rx1 - px + 1), iota);
+        zx[k] = plane_x8(plane, lane_x8(px));
+        #pragma GCC unroll 3
+        for (int i = 0; i < 3; ++i) {
+            const __m256i lane_sx = _mm256_mullo_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(sx[i])), iota);
+            e[k][i] = _mm256_sub_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(e_row[i] - sx[i] * 8 * k)), lane_sx);
+        }
+    }
+    const __m256i zero_i = _mm256_setzero_si256();
+    std::uint64_t passed = 0;
+    std::uint32_t* row = depth.row(ry0);
+    for (int py = ry0; py <= ry1; ++py, row += depth.stride) {
+        const __m256 fy = _mm256_set1_ps(static_cast<float>(py));
+        #pragma GCC unroll 2
+        for (int k = 0; k < Columns; ++k) {
+            __m256i cover = in_rect[k];
+            #pragma GCC unroll 3
+            for (int i = 0; i < 3; ++i) {
+                cover = _mm256_and_si256(cover, _mm256_cmpgt_epi32(e[k][i], zero_i));
+                e[k][i] = _mm256_add_epi32(e[k][i], step_y[i]);  // the next row (unused after the last)
+            }
+            const unsigned m = lanes(cover);
+            if (m == 0) continue;
+            passed += static_cast<unsigned>(
+                std::popcount(chunk8<Fmt, F, Write>(plane, row, rx0 + 8 * k, fy, cover, m == 0xffu, zx[k])));
+        }
+        if (stop_at_first && passed != 0) return passed;
+    }
+    return passed;
+}
+
 template <DepthFormat Fmt, DepthFunc F, bool Write>
 std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, bool stop_at_first) {
     const int rx0 = rect.x0, ry0 = rect.y0, rx1 = rect.x1, ry1 = rect.y1;
@@ -171,45 +232,8 @@ std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, b
             fits = fits && bound < (std::int64_t{1} << 31);
         }
         if (fits) {
-            // At most two columns of 8 pixels (width <= 16). Per column, set up once: the lanes'
-            // edge values in the first row (stepped by the y steps per row, every value an edge
-            // value of a pixel of the padded rectangle, so within the bound), the in-rectangle
-            // lanes and the inner fma of the depth plane.
-            const int columns = (rx1 - rx0) / 8 + 1;
-            __m256i e[2][3], in_rect[2], step_y[3];
-            __m256 zx[2];
-            #pragma GCC unroll 3
-            for (int i = 0; i < 3; ++i) step_y[i] = _mm256_set1_epi32(static_cast<std::int32_t>(sy[i]));
-            for (int k = 0; k < columns; ++k) {
-                const int px = rx0 + 8 * k;
-                in_rect[k] = _mm256_cmpgt_epi32(_mm256_set1_epi32(rx1 - px + 1), iota);
-                zx[k] = plane_x8(t, px);
-                #pragma GCC unroll 3
-                for (int i = 0; i < 3; ++i) {
-                    const __m256i lane_sx = _mm256_mullo_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(sx[i])), iota);
-                    e[k][i] = _mm256_sub_epi32(
-                        _mm256_set1_epi32(static_cast<std::int32_t>(e_row[i] - sx[i] * 8 * k)), lane_sx);
-                }
-            }
-            const __m256i zero_i = _mm256_setzero_si256();
-            for (int py = ry0; py <= ry1; ++py) {
-                std::uint32_t* row = depth.row(py);
-                const __m256 fy = _mm256_set1_ps(static_cast<float>(py));
-                for (int k = 0; k < columns; ++k) {
-                    __m256i cover = in_rect[k];
-                    #pragma GCC unroll 3
-                    for (int i = 0; i < 3; ++i) {
-                        cover = _mm256_and_si256(cover, _mm256_cmpgt_epi32(e[k][i], zero_i));
-                        e[k][i] = _mm256_add_epi32(e[k][i], step_y[i]);  // the next row (unused after the last)
-                    }
-                    const unsigned m = lanes(cover);
-                    if (m == 0) continue;
-                    passed += static_cast<unsigned>(
-                        std::popcount(chunk8<Fmt, F, Write>(t, row, rx0 + 8 * k, fy, cover, m == 0xffu, zx[k])));
-                }
-                if (stop_at_first && passed != 0) return passed;
-            }
-            return passed;
+            return rx1 - rx0 < 8 ? narrow_rows<1, Fmt, F, Write>(t, depth, rect, e_row, sx, sy, stop_at_first)
+                                 : narrow_rows<2, Fmt, F, Write>(t, depth, rect, e_row, sx, sy, stop_at_first);
         }
     }
 
@@ -250,6 +274,8 @@ std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, b
         if (s < 0) lower[n_lower++].init(-base, -sy, -s);   // px >= floor(-base / -s) + 1
     }
     const __m256i all = _mm256_set1_epi32(-1);
+    const __m256 eight = _mm256_set1_ps(8.0f);
+    const Plane8 plane(t);
     for (int py = y0; py <= y1; ++py) {
         std::int64_t lo = rx0, hi = rx1;
         for (int k = 0; k < n_upper; ++k) {
@@ -265,11 +291,12 @@ std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, b
         const __m256 fy = _mm256_set1_ps(static_cast<float>(py));
         const int ihi = static_cast<int>(hi);
         int px = static_cast<int>(lo);
-        for (; px + 7 <= ihi; px += 8)
-            passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(t, row, px, fy, all, true, plane_x8(t, px))));
+        __m256 fx = lane_x8(px);  // stepped by 8 per chunk: exact, |px| < 2^24
+        for (; px + 7 <= ihi; px += 8, fx = _mm256_add_ps(fx, eight))
+            passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(plane, row, px, fy, all, true, plane_x8(plane, fx))));
         if (px <= ihi) {
             const __m256i cover = _mm256_cmpgt_epi32(_mm256_set1_epi32(ihi - px + 1), iota);
-            passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(t, row, px, fy, cover, false, plane_x8(t, px))));
+            passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(plane, row, px, fy, cover, false, plane_x8(plane, fx))));
         }
         if (stop_at_first && passed != 0) return passed;
     }
