@@ -350,6 +350,8 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
         hiz->valid = 0;  // bounds are read from the buffer afresh in every batch
     }
     bool wrote = false;
+    std::uint32_t kernel_cmd = kNoQuery;  // the command `kernel` was selected for
+    detail::RectKernel kernel = nullptr;
     for (const Ref& r : bin) {
         const std::uint32_t cmd = ctx.draws.cmds[r.draw];
         const Command& c = cmds[cmd];
@@ -378,8 +380,11 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
             if ((rect.x0 != tri.x0 || rect.y0 != tri.y0 || rect.x1 != tri.x1 || rect.y1 != tri.y1) &&
                 !detail::shrink_rect(tri, rect))
                 continue;
-            passed = hiz != nullptr ? detail::raster_rect_hiz(tri, depth_state, ctx.depth, rect, *hiz, ctx.allow_simd, any_only)
-                             : detail::raster_rect(tri, depth_state, ctx.depth, rect, ctx.allow_simd, any_only);
+            if (cmd != kernel_cmd) {  // consecutive references of a bin are mostly of one draw
+                kernel = detail::select_rect_kernel(depth_state, ctx.allow_simd, hiz != nullptr);
+                kernel_cmd = cmd;
+            }
+            passed = kernel(tri, ctx.depth, rect, hiz, any_only);
             if (any_only && passed != 0) ctx.answered[q].store(true, std::memory_order_relaxed);
         }
         if (q == kNoQuery || passed == 0) continue;

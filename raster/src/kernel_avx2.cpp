@@ -306,25 +306,15 @@ std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, b
 }  // namespace
 #endif
 
-std::uint64_t raster_rect_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
-                               bool stop_at_first) {
+namespace {
 #if defined(RASTER_KERNEL_AVX2)
-    return dispatch_depth(state, [&]<DepthFormat Fmt, DepthFunc F, bool Write>() {
-        return raster_rect8<Fmt, F, Write>(tri, depth, rect, stop_at_first);
-    });
-#else
-    return avx2::raster_rect_kernel(tri, state, depth, rect, stop_at_first);
-#endif
-}
-
-std::uint64_t raster_rect_hiz_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
-                                   HizTile& hiz, bool stop_at_first) {
-#if defined(RASTER_KERNEL_AVX2)
-    const auto plain = [&]<DepthFormat Fmt, DepthFunc F, bool Write>(PixelRect r) {
+struct Avx2Kernel {
+    template <DepthFormat Fmt, DepthFunc F, bool Write>
+    static std::uint64_t rect(const SetupTri& tri, DepthRows depth, PixelRect r, bool stop_at_first) {
         return raster_rect8<Fmt, F, Write>(tri, depth, r, stop_at_first);
-    };
+    }
     // Unsigned min / max of 8 pixels per row (whole 8-pixel blocks; the scalar loop otherwise).
-    const auto scan = [](DepthRows d, int x0, int y0, int x1, int y1, std::uint32_t& lo, std::uint32_t& hi) {
+    static void scan(DepthRows d, int x0, int y0, int x1, int y1, std::uint32_t& lo, std::uint32_t& hi) {
         if (x1 - x0 != 7) return avx2::stored_bounds(d, x0, y0, x1, y1, lo, hi);
         __m256i l = _mm256_set1_epi32(-1), h = _mm256_setzero_si256();
         for (int y = y0; y <= y1; ++y) {
@@ -340,16 +330,33 @@ std::uint64_t raster_rect_hiz_avx2(const SetupTri& tri, const DepthState& state,
         h4 = _mm_max_epu32(h4, _mm_shuffle_epi32(h4, 0xb1));
         lo = static_cast<std::uint32_t>(_mm_cvtsi128_si32(l4));
         hi = static_cast<std::uint32_t>(_mm_cvtsi128_si32(h4));
-    };
+    }
+};
 #else
-    const auto plain = [&]<DepthFormat Fmt, DepthFunc F, bool Write>(PixelRect r) {
+struct Avx2Kernel {  // the scalar kernel, built in this file's namespace
+    template <DepthFormat Fmt, DepthFunc F, bool Write>
+    static std::uint64_t rect(const SetupTri& tri, DepthRows depth, PixelRect r, bool stop_at_first) {
         return avx2::raster_rect_t<Fmt, F, Write>(tri, depth, r, stop_at_first);
-    };
-    const auto scan = [](DepthRows d, int x0, int y0, int x1, int y1, std::uint32_t& lo, std::uint32_t& hi) {
+    }
+    static void scan(DepthRows d, int x0, int y0, int x1, int y1, std::uint32_t& lo, std::uint32_t& hi) {
         avx2::stored_bounds(d, x0, y0, x1, y1, lo, hi);
-    };
+    }
+};
 #endif
-    return avx2::raster_rect_hiz_with(tri, state, depth, rect, hiz, stop_at_first, plain, scan);
+}  // namespace
+
+RectKernel select_rect_kernel_avx2(const DepthState& state, bool hiz) {
+    return avx2::select_rect_kernel_with<Avx2Kernel>(state, hiz);
+}
+
+std::uint64_t raster_rect_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
+                               bool stop_at_first) {
+    return select_rect_kernel_avx2(state, false)(tri, depth, rect, nullptr, stop_at_first);
+}
+
+std::uint64_t raster_rect_hiz_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
+                                   HizTile& hiz, bool stop_at_first) {
+    return select_rect_kernel_avx2(state, true)(tri, depth, rect, &hiz, stop_at_first);
 }
 
 bool kernel_avx2_available() {

@@ -118,6 +118,16 @@ std::uint64_t raster_rect_hiz_portable(const SetupTri& tri, const DepthState& st
 std::uint64_t raster_rect_hiz_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
                                    HizTile& hiz, bool stop_at_first);
 
+// The kernel that raster_rect (hiz false) or raster_rect_hiz (hiz true) runs for a draw's depth
+// state, resolved once: the tiled executor picks it per draw instead of dispatching per rectangle
+// (the two dispatch layers cost about 100 instructions per rectangle). `hiz` is the HizTile of the
+// rectangle's tile for a kernel selected with hiz = true, else ignored (may be nullptr).
+using RectKernel = std::uint64_t (*)(const SetupTri& tri, DepthRows depth, PixelRect rect, HizTile* hiz,
+                                     bool stop_at_first);
+RectKernel select_rect_kernel(const DepthState& state, bool allow_simd, bool hiz);
+RectKernel select_rect_kernel_portable(const DepthState& state, bool hiz);
+RectKernel select_rect_kernel_avx2(const DepthState& state, bool hiz);
+
 // True when the CPU has AVX2 and FMA and this build has the AVX2 kernel (x86-64 GCC/Clang).
 bool kernel_avx2_available();
 // False when CULLIDE_RASTER_NO_SIMD forces the portable kernel everywhere (read once).
