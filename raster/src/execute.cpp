@@ -297,15 +297,17 @@ void bin(const SetupDraws& setup, std::size_t n_draws, const Tiles& tiles, int t
                     continue;
                 }
                 // GL-exact triangles over several tiles: tile-level trivial reject (no centre of the
-                // tile's part of the box is covered), exact integers (detail::rect_outside).
-                for (int ty = ty0; ty <= ty1; ++ty)
+                // tile's part of the box is covered), exact integers (detail::RectReject, the
+                // corner test of detail::rect_outside with the row part set once per row of tiles).
+                detail::RectReject reject(tri);
+                for (int ty = ty0; ty <= ty1; ++ty) {
+                    reject.set_rows(std::max(tri.y0, ty * kTileSize), std::min(tri.y1, ty * kTileSize + kTileSize - 1));
                     for (int tx = tri.x0 / kTileSize; tx <= tri.x1 / kTileSize; ++tx) {
                         const int rx0 = std::max(tri.x0, tx * kTileSize);
                         const int rx1 = std::min(tri.x1, tx * kTileSize + kTileSize - 1);
-                        const int ry0 = std::max(tri.y0, ty * kTileSize);
-                        const int ry1 = std::min(tri.y1, ty * kTileSize + kTileSize - 1);
-                        if (!detail::rect_outside(tri, rx0, ry0, rx1, ry1)) add(d, t, tx, ty);
+                        if (!reject.outside(rx0, rx1)) add(d, t, tx, ty);
                     }
+                }
             }
             for (std::size_t t = 0; t < setup.bounds[d].size(); ++t) {
                 const auto& tri = setup.bounds[d][t];

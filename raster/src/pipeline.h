@@ -133,16 +133,40 @@ bool kernel_avx2_available();
 // False when CULLIDE_RASTER_NO_SIMD forces the portable kernel everywhere (read once).
 bool simd_allowed_by_environment();
 
+// rect_outside (below) for many rectangles of one triangle, as binning asks it tile by tile: an
+// edge e = c - sx px + sy py is largest over a rectangle at the corner that the signs of sx and sy
+// pick (the larger of -sx x0, -sx x1 and of sy y0, sy y1), so the row part is set once per row of
+// tiles and a tile costs one product per edge. The same integers as the four-corner maximum.
+class RectReject {
+public:
+    explicit RectReject(const SetupTri& t) {
+        for (int i = 0; i < 3; ++i) {
+            sx_[i] = t.dcdx[i] * 256;
+            sy_[i] = t.dcdy[i] * 256;
+            c_[i] = t.c[i];
+        }
+    }
+    // The rows [y0, y1] of the next rectangles.
+    void set_rows(int y0, int y1) {
+        for (int i = 0; i < 3; ++i) row_best_[i] = c_[i] + (sy_[i] > 0 ? sy_[i] * y1 : sy_[i] * y0);
+    }
+    // True when no pixel centre of [x0, x1] x (the rows) can be covered.
+    [[nodiscard]] bool outside(int x0, int x1) const {
+        for (int i = 0; i < 3; ++i)
+            if (row_best_[i] - (sx_[i] < 0 ? sx_[i] * x1 : sx_[i] * x0) <= 0) return true;
+        return false;
+    }
+
+private:
+    std::int64_t sx_[3], sy_[3], c_[3], row_best_[3];
+};
+
 // True when no pixel centre of [x0, x1] x [y0, y1] can be covered by `t`: one edge function is <= 0
 // at all four corner centres (edge functions are linear, so at every centre). Exact integers.
 inline bool rect_outside(const SetupTri& t, int x0, int y0, int x1, int y1) {
-    for (int i = 0; i < 3; ++i) {
-        const std::int64_t ex0 = -t.dcdx[i] * 256 * x0, ex1 = -t.dcdx[i] * 256 * x1;
-        const std::int64_t ey0 = t.dcdy[i] * 256 * y0, ey1 = t.dcdy[i] * 256 * y1;
-        const std::int64_t best = t.c[i] + std::max(ex0, ex1) + std::max(ey0, ey1);
-        if (best <= 0) return true;
-    }
-    return false;
+    RectReject r(t);
+    r.set_rows(y0, y1);
+    return r.outside(x0, x1);
 }
 
 // Floor of a / b for b > 0 (exact integers).
