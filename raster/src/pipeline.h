@@ -186,8 +186,8 @@ inline bool rect_outside(const SetupTri& t, int x0, int y0, int x1, int y1) {
 [[gnu::always_inline]] inline bool shrink_rect(const SetupTri& t, PixelRect& r) {
     for (int i = 0; i < 3; ++i) {
         const std::int64_t sx = t.dcdx[i] * 256, sy = t.dcdy[i] * 256;
-        const std::int64_t m = t.c[i] + std::max(-sx * r.x0, -sx * r.x1);  // e <= m + sy py on the row py
-        const std::int64_t top = m + sy * r.y0, bottom = m + sy * r.y1;    // that bound on the first, last row
+        const std::int64_t m = t.c[i] - sx * (sx < 0 ? r.x1 : r.x0);    // e <= m + sy py on the row py
+        const std::int64_t top = m + sy * r.y0, bottom = m + sy * r.y1;  // that bound on the first, last row
         if (top > 0 && bottom > 0) continue;
         if (top <= 0 && bottom <= 0) return false;
         if (sy > 0) r.y0 = static_cast<int>(floor_div_pos(-m, sy) + 1);  // top <= 0 < bottom
@@ -195,7 +195,7 @@ inline bool rect_outside(const SetupTri& t, int x0, int y0, int x1, int y1) {
     }
     for (int i = 0; i < 3; ++i) {
         const std::int64_t sx = t.dcdx[i] * 256, sy = t.dcdy[i] * 256;
-        const std::int64_t m = t.c[i] + std::max(sy * r.y0, sy * r.y1);  // e <= m - sx px on the column px
+        const std::int64_t m = t.c[i] + sy * (sy > 0 ? r.y1 : r.y0);     // e <= m - sx px on the column px
         const std::int64_t left = m - sx * r.x0, right = m - sx * r.x1;
         if (left > 0 && right > 0) continue;
         if (left <= 0 && right <= 0) return false;
