@@ -125,12 +125,13 @@ inline unsigned chunk8(const Plane8& plane, std::uint32_t* row, int px, __m256 f
     const __m256i pass = _mm256_and_si256(pass8<Fmt, F>(incoming, stored), cover);
     const unsigned bits = lanes(pass);
     if constexpr (Write) {
-        if (bits != 0) {
-            if (full)
-                _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), _mm256_blendv_epi8(stored, incoming, pass));
-            else
-                _mm256_maskstore_epi32(reinterpret_cast<int*>(p), pass, incoming);
-        }
+        // A full chunk is stored whether or not a lane passed (its pixels are this rectangle's,
+        // unchanged ones rewritten with their own value): the pass/fail pattern of writing draws
+        // is data, and a branch on it mispredicted (perf, cylinders frame).
+        if (full)
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), _mm256_blendv_epi8(stored, incoming, pass));
+        else if (bits != 0)
+            _mm256_maskstore_epi32(reinterpret_cast<int*>(p), pass, incoming);
     }
     return bits;
 }
@@ -148,13 +149,12 @@ struct EdgeWalk {
         dq = avx2::floor_div(step, d);
         dr = step - dq * d;
     }
-    void next() {
+    void next() {  // without a branch: the wrap-around follows the edge's slope, which no predictor knows
         q += dq;
         r += dr;
-        if (r >= d) {
-            r -= d;
-            ++q;
-        }
+        const std::int64_t wrap = r >= d ? 1 : 0;
+        q += wrap;
+        r -= d & -wrap;
     }
 };
 
