@@ -61,37 +61,38 @@ template <DepthFunc F, class T>
 
 namespace dispatch {
 
-template <DepthFormat Fmt, DepthFunc F, class Kernel>
-std::uint64_t by_write(bool write, Kernel& kernel) {
+template <class R, DepthFormat Fmt, DepthFunc F, class Kernel>
+R by_write(bool write, Kernel& kernel) {
     return write ? kernel.template operator()<Fmt, F, true>() : kernel.template operator()<Fmt, F, false>();
 }
 
-template <DepthFormat Fmt, class Kernel>
-std::uint64_t by_func(DepthFunc func, bool write, Kernel& kernel) {
+template <class R, DepthFormat Fmt, class Kernel>
+R by_func(DepthFunc func, bool write, Kernel& kernel) {
     switch (func) {
-        case DepthFunc::Never: return by_write<Fmt, DepthFunc::Never>(write, kernel);
-        case DepthFunc::Less: return by_write<Fmt, DepthFunc::Less>(write, kernel);
-        case DepthFunc::Equal: return by_write<Fmt, DepthFunc::Equal>(write, kernel);
-        case DepthFunc::LEqual: return by_write<Fmt, DepthFunc::LEqual>(write, kernel);
-        case DepthFunc::Greater: return by_write<Fmt, DepthFunc::Greater>(write, kernel);
-        case DepthFunc::NotEqual: return by_write<Fmt, DepthFunc::NotEqual>(write, kernel);
-        case DepthFunc::GEqual: return by_write<Fmt, DepthFunc::GEqual>(write, kernel);
-        case DepthFunc::Always: return by_write<Fmt, DepthFunc::Always>(write, kernel);
+        case DepthFunc::Never: return by_write<R, Fmt, DepthFunc::Never>(write, kernel);
+        case DepthFunc::Less: return by_write<R, Fmt, DepthFunc::Less>(write, kernel);
+        case DepthFunc::Equal: return by_write<R, Fmt, DepthFunc::Equal>(write, kernel);
+        case DepthFunc::LEqual: return by_write<R, Fmt, DepthFunc::LEqual>(write, kernel);
+        case DepthFunc::Greater: return by_write<R, Fmt, DepthFunc::Greater>(write, kernel);
+        case DepthFunc::NotEqual: return by_write<R, Fmt, DepthFunc::NotEqual>(write, kernel);
+        case DepthFunc::GEqual: return by_write<R, Fmt, DepthFunc::GEqual>(write, kernel);
+        case DepthFunc::Always: return by_write<R, Fmt, DepthFunc::Always>(write, kernel);
     }
-    return 0;
+    return R{};
 }
 
 }  // namespace dispatch
 
-// Returns kernel.operator()<state.format, state.func, state.write>(): the samples that passed.
-template <class Kernel>
-std::uint64_t dispatch_depth(const DepthState& state, Kernel&& kernel) {
+// Returns kernel.operator()<state.format, state.func, state.write>(): the samples that passed, or
+// (R other than the default) what the kernel functor returns, e.g. a pointer to an instantiation.
+template <class R = std::uint64_t, class Kernel>
+R dispatch_depth(const DepthState& state, Kernel&& kernel) {
     switch (state.format) {
-        case DepthFormat::D16: return dispatch::by_func<DepthFormat::D16>(state.func, state.write, kernel);
-        case DepthFormat::D24: return dispatch::by_func<DepthFormat::D24>(state.func, state.write, kernel);
-        case DepthFormat::D32F: return dispatch::by_func<DepthFormat::D32F>(state.func, state.write, kernel);
+        case DepthFormat::D16: return dispatch::by_func<R, DepthFormat::D16>(state.func, state.write, kernel);
+        case DepthFormat::D24: return dispatch::by_func<R, DepthFormat::D24>(state.func, state.write, kernel);
+        case DepthFormat::D32F: return dispatch::by_func<R, DepthFormat::D32F>(state.func, state.write, kernel);
     }
-    return 0;
+    return R{};
 }
 
 }  // namespace raster::detail

@@ -6,7 +6,8 @@
 // Layout: 8x1 pixels per step along a row. Coverage stays exact integer arithmetic on the same
 // 16.8 edge functions (same snapping, same fill-rule bias folded into c): narrow rectangles test
 // 8 pixels at once in 32-bit lanes when a bound proves no value overflows; wider ones solve each
-// row's covered span with the scalar code (edge_span of raster_kernel.inc, 64-bit floor divisions).
+// row's covered span from the 64-bit edge functions: the scalar code's floor divisions (edge_span
+// of raster_kernel.inc), done once per rectangle and then stepped row to row (EdgeWalk).
 // Either way the covered set is the scalar path's. The vector part is depth; per 8 pixels:
 //   z = fma(dzdy, y, fma(dzdx, x, z0))   (_mm256_fmadd_ps: one correctly rounded fma, as std::fma)
 //   clamp: max(z, 0) then min(z, 1)      (maxps returns its second operand when z is NaN: NaN -> 0,
@@ -68,15 +69,15 @@ inline __m256i pass8(__m256i incoming, __m256i stored) {
         if constexpr (F == DepthFunc::NotEqual) return _mm256_castps_si256(_mm256_cmp_ps(a, b, _CMP_NEQ_UQ));
         if constexpr (F == DepthFunc::GEqual) return _mm256_castps_si256(_mm256_cmp_ps(a, b, _CMP_GE_OQ));
     } else {
-        // Unsigned 32-bit order through a sign flip and the signed compare.
-        const __m256i bias = _mm256_set1_epi32(static_cast<int>(0x80000000u));
-        const __m256i a = _mm256_xor_si256(incoming, bias), b = _mm256_xor_si256(stored, bias);
-        if constexpr (F == DepthFunc::Less) return _mm256_cmpgt_epi32(b, a);
+        // Unsigned 32-bit order: a <= b exactly when the unsigned maximum of the two is b (two
+        // instructions; a sign flip of both and the signed compare took three or four).
+        const __m256i a = incoming, b = stored, top = _mm256_max_epu32(a, b);
+        if constexpr (F == DepthFunc::Less) return _mm256_xor_si256(_mm256_cmpeq_epi32(top, a), ones);
         if constexpr (F == DepthFunc::Equal) return _mm256_cmpeq_epi32(a, b);
-        if constexpr (F == DepthFunc::LEqual) return _mm256_xor_si256(_mm256_cmpgt_epi32(a, b), ones);
-        if constexpr (F == DepthFunc::Greater) return _mm256_cmpgt_epi32(a, b);
+        if constexpr (F == DepthFunc::LEqual) return _mm256_cmpeq_epi32(top, b);
+        if constexpr (F == DepthFunc::Greater) return _mm256_xor_si256(_mm256_cmpeq_epi32(top, b), ones);
         if constexpr (F == DepthFunc::NotEqual) return _mm256_xor_si256(_mm256_cmpeq_epi32(a, b), ones);
-        if constexpr (F == DepthFunc::GEqual) return _mm256_xor_si256(_mm256_cmpgt_epi32(b, a), ones);
+        if constexpr (F == DepthFunc::GEqual) return _mm256_cmpeq_epi32(top, a);
     }
     return _mm256_setzero_si256();
 }
@@ -90,20 +91,31 @@ inline std::int64_t edge_at(const SetupTri& t, int i, int px, int py) {
     return t.c[i] - t.dcdx[i] * 256 * px + t.dcdy[i] * 256 * py;
 }
 
-// Depth test (and write) of the 8 pixels px..px+7 of `row` at row centre fy; `cover` marks the
-// pixels to process (full: all 8, plain load and blended store). Returns the passing-lane bits.
-// The inner fma of the depth plane for the 8 pixels px..px+7: fma(dzdx, x, z0), the same in every row.
-inline __m256 plane_x8(const SetupTri& t, int px) {
+// The depth plane's coefficients in every lane, read from the SetupTri once per rectangle (a
+// store through __m256i may alias anything, so loops that read them from `t` reload them after
+// every store).
+struct Plane8 {
+    __m256 z0, dzdx, dzdy;
+    explicit Plane8(const SetupTri& t)
+        : z0(_mm256_set1_ps(t.z0)), dzdx(_mm256_set1_ps(t.dzdx)), dzdy(_mm256_set1_ps(t.dzdy)) {}
+};
+
+// The x coordinates px..px+7 as floats (exact: |px| < 2^24).
+inline __m256 lane_x8(int px) {
     const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-    const __m256 fx = _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(px), iota));
-    return _mm256_fmadd_ps(_mm256_set1_ps(t.dzdx), fx, _mm256_set1_ps(t.z0));
+    return _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(px), iota));
 }
 
-// zx: plane_x8(t, px), computed once per column of chunks by callers that visit it in many rows.
+// The inner fma of the depth plane for the 8 pixels at x = fx: fma(dzdx, x, z0), the same in every row.
+inline __m256 plane_x8(const Plane8& p, __m256 fx) { return _mm256_fmadd_ps(p.dzdx, fx, p.z0); }
+
+// Depth test (and write) of the 8 pixels px..px+7 of `row` at row centre fy; `cover` marks the
+// pixels to process (full: all 8, plain load and blended store). Returns the passing-lane bits.
+// zx: plane_x8 of the 8 pixels, computed once per column of chunks by callers that visit it in many rows.
 template <DepthFormat Fmt, DepthFunc F, bool Write>
-inline unsigned chunk8(const SetupTri& t, std::uint32_t* row, int px, __m256 fy, __m256i cover, bool full,
+inline unsigned chunk8(const Plane8& plane, std::uint32_t* row, int px, __m256 fy, __m256i cover, bool full,
                        __m256 zx) {
-    __m256 z = _mm256_fmadd_ps(_mm256_set1_ps(t.dzdy), fy, zx);
+    __m256 z = _mm256_fmadd_ps(plane.dzdy, fy, zx);
     z = _mm256_max_ps(z, _mm256_setzero_ps());
     z = _mm256_min_ps(z, _mm256_set1_ps(1.0f));
     const __m256i incoming = encode8<Fmt>(z);
@@ -113,17 +125,90 @@ inline unsigned chunk8(const SetupTri& t, std::uint32_t* row, int px, __m256 fy,
     const __m256i pass = _mm256_and_si256(pass8<Fmt, F>(incoming, stored), cover);
     const unsigned bits = lanes(pass);
     if constexpr (Write) {
-        if (bits != 0) {
-            if (full)
-                _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), _mm256_blendv_epi8(stored, incoming, pass));
-            else
-                _mm256_maskstore_epi32(reinterpret_cast<int*>(p), pass, incoming);
-        }
+        // A full chunk is stored whether or not a lane passed (its pixels are this rectangle's,
+        // unchanged ones rewritten with their own value): the pass/fail pattern of writing draws
+        // is data, and a branch on it mispredicted (perf, cylinders frame).
+        if (full)
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), _mm256_blendv_epi8(stored, incoming, pass));
+        else if (bits != 0)
+            _mm256_maskstore_epi32(reinterpret_cast<int*>(p), pass, incoming);
     }
     return bits;
 }
 
+// floor(n(py) / d) for successive rows py, n(py) = n(y0) + step * (py - y0), d > 0: quotient and
+// remainder stepped by the step's own quotient and remainder (the integer walk of Bresenham's
+// line algorithm), so a row costs adds and one compare instead of a 64-bit division; the same
+// integers as floor_div on every row.
+struct EdgeWalk {
+    std::int64_t q, r, dq, dr, d;  // n = q d + r, 0 <= r < d; step = dq d + dr, 0 <= dr < d
+    void init(std::int64_t n, std::int64_t step, std::int64_t div) {
+        d = div;
+        q = avx2::floor_div(n, d);
+        r = n - q * d;
+        dq = avx2::floor_div(step, d);
+        dr = step - dq * d;
+    }
+    void next() {  // without a branch: the wrap-around follows the edge's slope, which no predictor knows
+        q += dq;
+        r += dr;
+        const std::int64_t wrap = r >= d ? 1 : 0;
+        q += wrap;
+        r -= d & -wrap;
+    }
+};
+
 constexpr int kNarrow = 16;  // rectangles narrower than this take the per-chunk edge path when it fits
+
+// The narrow path of raster_rect8 (below) for a rectangle of `Columns` chunks of 8 pixels (1 or
+// 2), given each edge's value at (rx0, ry0) and its x and y steps, all known to fit in 32 bits over
+// the rectangle padded to whole chunks. Per column, set up once: the lanes' edge values in the
+// first row (stepped by the y steps per row, every value an edge value of a pixel of the padded
+// rectangle, so within the bound), the in-rectangle lanes and the inner fma of the depth plane.
+// The column count is a constant so that the edge vectors stay in registers across rows.
+template <int Columns, DepthFormat Fmt, DepthFunc F, bool Write>
+std::uint64_t narrow_rows(const SetupTri& t, DepthRows depth, PixelRect rect, const std::int64_t (&e_row)[3],
+                          const std::int64_t (&sx)[3], const std::int64_t (&sy)[3], bool stop_at_first) {
+    const int rx0 = rect.x0, ry0 = rect.y0, rx1 = rect.x1, ry1 = rect.y1;
+    const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const Plane8 plane(t);
+    __m256i e[Columns][3], in_rect[Columns], step_y[3];
+    __m256 zx[Columns];
+    #pragma GCC unroll 3
+    for (int i = 0; i < 3; ++i) step_y[i] = _mm256_set1_epi32(static_cast<std::int32_t>(sy[i]));
+    #pragma GCC unroll 2
+    for (int k = 0; k < Columns; ++k) {
+        const int px = rx0 + 8 * k;
+        in_rect[k] = _mm256_cmpgt_epi32(_mm256_set1_epi32(rx1 - px + 1), iota);
+        zx[k] = plane_x8(plane, lane_x8(px));
+        #pragma GCC unroll 3
+        for (int i = 0; i < 3; ++i) {
+            const __m256i lane_sx = _mm256_mullo_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(sx[i])), iota);
+            e[k][i] = _mm256_sub_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(e_row[i] - sx[i] * 8 * k)), lane_sx);
+        }
+    }
+    const __m256i zero_i = _mm256_setzero_si256();
+    std::uint64_t passed = 0;
+    std::uint32_t* row = depth.row(ry0);
+    for (int py = ry0; py <= ry1; ++py, row += depth.stride) {
+        const __m256 fy = _mm256_set1_ps(static_cast<float>(py));
+        #pragma GCC unroll 2
+        for (int k = 0; k < Columns; ++k) {
+            __m256i cover = in_rect[k];
+            #pragma GCC unroll 3
+            for (int i = 0; i < 3; ++i) {
+                cover = _mm256_and_si256(cover, _mm256_cmpgt_epi32(e[k][i], zero_i));
+                e[k][i] = _mm256_add_epi32(e[k][i], step_y[i]);  // the next row (unused after the last)
+            }
+            const unsigned m = lanes(cover);
+            if (m == 0) continue;
+            passed += static_cast<unsigned>(
+                std::popcount(chunk8<Fmt, F, Write>(plane, row, rx0 + 8 * k, fy, cover, m == 0xffu, zx[k])));
+        }
+        if (stop_at_first && passed != 0) return passed;
+    }
+    return passed;
+}
 
 template <DepthFormat Fmt, DepthFunc F, bool Write>
 std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, bool stop_at_first) {
@@ -147,45 +232,8 @@ std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, b
             fits = fits && bound < (std::int64_t{1} << 31);
         }
         if (fits) {
-            // At most two columns of 8 pixels (width <= 16). Per column, set up once: the lanes'
-            // edge values in the first row (stepped by the y steps per row, every value an edge
-            // value of a pixel of the padded rectangle, so within the bound), the in-rectangle
-            // lanes and the inner fma of the depth plane.
-            const int columns = (rx1 - rx0) / 8 + 1;
-            __m256i e[2][3], in_rect[2], step_y[3];
-            __m256 zx[2];
-            #pragma GCC unroll 3
-            for (int i = 0; i < 3; ++i) step_y[i] = _mm256_set1_epi32(static_cast<std::int32_t>(sy[i]));
-            for (int k = 0; k < columns; ++k) {
-                const int px = rx0 + 8 * k;
-                in_rect[k] = _mm256_cmpgt_epi32(_mm256_set1_epi32(rx1 - px + 1), iota);
-                zx[k] = plane_x8(t, px);
-                #pragma GCC unroll 3
-                for (int i = 0; i < 3; ++i) {
-                    const __m256i lane_sx = _mm256_mullo_epi32(_mm256_set1_epi32(static_cast<std::int32_t>(sx[i])), iota);
-                    e[k][i] = _mm256_sub_epi32(
-                        _mm256_set1_epi32(static_cast<std::int32_t>(e_row[i] - sx[i] * 8 * k)), lane_sx);
-                }
-            }
-            const __m256i zero_i = _mm256_setzero_si256();
-            for (int py = ry0; py <= ry1; ++py) {
-                std::uint32_t* row = depth.row(py);
-                const __m256 fy = _mm256_set1_ps(static_cast<float>(py));
-                for (int k = 0; k < columns; ++k) {
-                    __m256i cover = in_rect[k];
-                    #pragma GCC unroll 3
-                    for (int i = 0; i < 3; ++i) {
-                        cover = _mm256_and_si256(cover, _mm256_cmpgt_epi32(e[k][i], zero_i));
-                        e[k][i] = _mm256_add_epi32(e[k][i], step_y[i]);  // the next row (unused after the last)
-                    }
-                    const unsigned m = lanes(cover);
-                    if (m == 0) continue;
-                    passed += static_cast<unsigned>(
-                        std::popcount(chunk8<Fmt, F, Write>(t, row, rx0 + 8 * k, fy, cover, m == 0xffu, zx[k])));
-                }
-                if (stop_at_first && passed != 0) return passed;
-            }
-            return passed;
+            return rx1 - rx0 < 8 ? narrow_rows<1, Fmt, F, Write>(t, depth, rect, e_row, sx, sy, stop_at_first)
+                                 : narrow_rows<2, Fmt, F, Write>(t, depth, rect, e_row, sx, sy, stop_at_first);
         }
     }
 
@@ -200,24 +248,55 @@ std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, b
         if (!(e00 > 0 && e10 > 0 && e01 > 0 && e11 > 0)) edges[n_edges++] = i;  // else trivially inside
     }
 
-    // Otherwise each row's span from the 64-bit edge functions (the scalar solver).
+    // Otherwise each row's span from the 64-bit edge functions: the scalar solver's floor
+    // divisions (edge_span of raster_kernel.inc), stepped from row to row without dividing
+    // (EdgeWalk). An edge constant along rows (dcdx = 0) bounds the rows instead, exactly.
+    EdgeWalk upper[3], lower[3];  // bounds on the last / first covered column
+    int n_upper = 0, n_lower = 0;
+    int y0 = ry0, y1 = ry1;
+    for (int k = 0; k < n_edges; ++k) {
+        const int i = edges[k];
+        const std::int64_t s = t.dcdx[i] * 256, sy = t.dcdy[i] * 256;
+        if (s != 0) continue;
+        if (sy > 0) {
+            y0 = static_cast<int>(std::max<std::int64_t>(y0, avx2::floor_div(-t.c[i], sy) + 1));
+        } else if (sy < 0) {
+            y1 = static_cast<int>(std::min<std::int64_t>(y1, avx2::floor_div(t.c[i] - 1, -sy)));
+        } else if (t.c[i] <= 0) {
+            return 0;
+        }
+    }
+    for (int k = 0; k < n_edges; ++k) {
+        const int i = edges[k];
+        const std::int64_t s = t.dcdx[i] * 256, sy = t.dcdy[i] * 256;
+        const std::int64_t base = t.c[i] + sy * y0;  // e(px) = base - s px on the row y0
+        if (s > 0) upper[n_upper++].init(base - 1, sy, s);  // px <= floor((base - 1) / s)
+        if (s < 0) lower[n_lower++].init(-base, -sy, -s);   // px >= floor(-base / -s) + 1
+    }
     const __m256i all = _mm256_set1_epi32(-1);
-    for (int py = ry0; py <= ry1; ++py) {
+    const __m256 eight = _mm256_set1_ps(8.0f);
+    const Plane8 plane(t);
+    for (int py = y0; py <= y1; ++py) {
         std::int64_t lo = rx0, hi = rx1;
-        for (int k = 0; k < n_edges; ++k) {
-            const int i = edges[k];
-            avx2::edge_span(t.c[i] + t.dcdy[i] * 256 * py, t.dcdx[i], lo, hi);
+        for (int k = 0; k < n_upper; ++k) {
+            hi = std::min(hi, upper[k].q);
+            upper[k].next();
+        }
+        for (int k = 0; k < n_lower; ++k) {
+            lo = std::max(lo, lower[k].q + 1);
+            lower[k].next();
         }
         if (lo > hi) continue;
         std::uint32_t* row = depth.row(py);
         const __m256 fy = _mm256_set1_ps(static_cast<float>(py));
         const int ihi = static_cast<int>(hi);
         int px = static_cast<int>(lo);
-        for (; px + 7 <= ihi; px += 8)
-            passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(t, row, px, fy, all, true, plane_x8(t, px))));
+        __m256 fx = lane_x8(px);  // stepped by 8 per chunk: exact, |px| < 2^24
+        for (; px + 7 <= ihi; px += 8, fx = _mm256_add_ps(fx, eight))
+            passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(plane, row, px, fy, all, true, plane_x8(plane, fx))));
         if (px <= ihi) {
             const __m256i cover = _mm256_cmpgt_epi32(_mm256_set1_epi32(ihi - px + 1), iota);
-            passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(t, row, px, fy, cover, false, plane_x8(t, px))));
+            passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(plane, row, px, fy, cover, false, plane_x8(plane, fx))));
         }
         if (stop_at_first && passed != 0) return passed;
     }
@@ -227,25 +306,15 @@ std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, b
 }  // namespace
 #endif
 
-std::uint64_t raster_rect_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
-                               bool stop_at_first) {
+namespace {
 #if defined(RASTER_KERNEL_AVX2)
-    return dispatch_depth(state, [&]<DepthFormat Fmt, DepthFunc F, bool Write>() {
-        return raster_rect8<Fmt, F, Write>(tri, depth, rect, stop_at_first);
-    });
-#else
-    return avx2::raster_rect_kernel(tri, state, depth, rect, stop_at_first);
-#endif
-}
-
-std::uint64_t raster_rect_hiz_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
-                                   HizTile& hiz, bool stop_at_first) {
-#if defined(RASTER_KERNEL_AVX2)
-    const auto plain = [&]<DepthFormat Fmt, DepthFunc F, bool Write>(PixelRect r) {
+struct Avx2Kernel {
+    template <DepthFormat Fmt, DepthFunc F, bool Write>
+    static std::uint64_t rect(const SetupTri& tri, DepthRows depth, PixelRect r, bool stop_at_first) {
         return raster_rect8<Fmt, F, Write>(tri, depth, r, stop_at_first);
-    };
+    }
     // Unsigned min / max of 8 pixels per row (whole 8-pixel blocks; the scalar loop otherwise).
-    const auto scan = [](DepthRows d, int x0, int y0, int x1, int y1, std::uint32_t& lo, std::uint32_t& hi) {
+    static void scan(DepthRows d, int x0, int y0, int x1, int y1, std::uint32_t& lo, std::uint32_t& hi) {
         if (x1 - x0 != 7) return avx2::stored_bounds(d, x0, y0, x1, y1, lo, hi);
         __m256i l = _mm256_set1_epi32(-1), h = _mm256_setzero_si256();
         for (int y = y0; y <= y1; ++y) {
@@ -261,16 +330,33 @@ std::uint64_t raster_rect_hiz_avx2(const SetupTri& tri, const DepthState& state,
         h4 = _mm_max_epu32(h4, _mm_shuffle_epi32(h4, 0xb1));
         lo = static_cast<std::uint32_t>(_mm_cvtsi128_si32(l4));
         hi = static_cast<std::uint32_t>(_mm_cvtsi128_si32(h4));
-    };
+    }
+};
 #else
-    const auto plain = [&]<DepthFormat Fmt, DepthFunc F, bool Write>(PixelRect r) {
+struct Avx2Kernel {  // the scalar kernel, built in this file's namespace
+    template <DepthFormat Fmt, DepthFunc F, bool Write>
+    static std::uint64_t rect(const SetupTri& tri, DepthRows depth, PixelRect r, bool stop_at_first) {
         return avx2::raster_rect_t<Fmt, F, Write>(tri, depth, r, stop_at_first);
-    };
-    const auto scan = [](DepthRows d, int x0, int y0, int x1, int y1, std::uint32_t& lo, std::uint32_t& hi) {
+    }
+    static void scan(DepthRows d, int x0, int y0, int x1, int y1, std::uint32_t& lo, std::uint32_t& hi) {
         avx2::stored_bounds(d, x0, y0, x1, y1, lo, hi);
-    };
+    }
+};
 #endif
-    return avx2::raster_rect_hiz_with(tri, state, depth, rect, hiz, stop_at_first, plain, scan);
+}  // namespace
+
+RectKernel select_rect_kernel_avx2(const DepthState& state, bool hiz) {
+    return avx2::select_rect_kernel_with<Avx2Kernel>(state, hiz);
+}
+
+std::uint64_t raster_rect_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
+                               bool stop_at_first) {
+    return select_rect_kernel_avx2(state, false)(tri, depth, rect, nullptr, stop_at_first);
+}
+
+std::uint64_t raster_rect_hiz_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
+                                   HizTile& hiz, bool stop_at_first) {
+    return select_rect_kernel_avx2(state, true)(tri, depth, rect, &hiz, stop_at_first);
 }
 
 bool kernel_avx2_available() {

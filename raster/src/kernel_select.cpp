@@ -14,6 +14,12 @@ bool simd_allowed_by_environment() {
     return ok;
 }
 
+RectKernel select_rect_kernel(const DepthState& state, bool allow_simd, bool hiz) {
+    if (allow_simd && kernel_avx2_available() && simd_allowed_by_environment())
+        return select_rect_kernel_avx2(state, hiz);
+    return select_rect_kernel_portable(state, hiz);
+}
+
 std::uint64_t raster_rect(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
                           bool allow_simd, bool stop_at_first) {
     if (allow_simd && kernel_avx2_available() && simd_allowed_by_environment())

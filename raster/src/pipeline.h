@@ -118,22 +118,91 @@ std::uint64_t raster_rect_hiz_portable(const SetupTri& tri, const DepthState& st
 std::uint64_t raster_rect_hiz_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
                                    HizTile& hiz, bool stop_at_first);
 
+// The kernel that raster_rect (hiz false) or raster_rect_hiz (hiz true) runs for a draw's depth
+// state, resolved once: the tiled executor picks it per draw instead of dispatching per rectangle
+// (the two dispatch layers cost about 100 instructions per rectangle). `hiz` is the HizTile of the
+// rectangle's tile for a kernel selected with hiz = true, else ignored (may be nullptr).
+using RectKernel = std::uint64_t (*)(const SetupTri& tri, DepthRows depth, PixelRect rect, HizTile* hiz,
+                                     bool stop_at_first);
+RectKernel select_rect_kernel(const DepthState& state, bool allow_simd, bool hiz);
+RectKernel select_rect_kernel_portable(const DepthState& state, bool hiz);
+RectKernel select_rect_kernel_avx2(const DepthState& state, bool hiz);
+
 // True when the CPU has AVX2 and FMA and this build has the AVX2 kernel (x86-64 GCC/Clang).
 bool kernel_avx2_available();
 // False when CULLIDE_RASTER_NO_SIMD forces the portable kernel everywhere (read once).
 bool simd_allowed_by_environment();
 
+// rect_outside (below) for many rectangles of one triangle, as binning asks it tile by tile: an
+// edge e = c - sx px + sy py is largest over a rectangle at the corner that the signs of sx and sy
+// pick (the larger of -sx x0, -sx x1 and of sy y0, sy y1), so the row part is set once per row of
+// tiles and a tile costs one product per edge. The same integers as the four-corner maximum.
+class RectReject {
+public:
+    explicit RectReject(const SetupTri& t) {
+        for (int i = 0; i < 3; ++i) {
+            sx_[i] = t.dcdx[i] * 256;
+            sy_[i] = t.dcdy[i] * 256;
+            c_[i] = t.c[i];
+        }
+    }
+    // The rows [y0, y1] of the next rectangles.
+    void set_rows(int y0, int y1) {
+        for (int i = 0; i < 3; ++i) row_best_[i] = c_[i] + (sy_[i] > 0 ? sy_[i] * y1 : sy_[i] * y0);
+    }
+    // True when no pixel centre of [x0, x1] x (the rows) can be covered.
+    [[nodiscard]] bool outside(int x0, int x1) const {
+        for (int i = 0; i < 3; ++i)
+            if (row_best_[i] - (sx_[i] < 0 ? sx_[i] * x1 : sx_[i] * x0) <= 0) return true;
+        return false;
+    }
+
+private:
+    std::int64_t sx_[3], sy_[3], c_[3], row_best_[3];
+};
+
 // True when no pixel centre of [x0, x1] x [y0, y1] can be covered by `t`: one edge function is <= 0
 // at all four corner centres (edge functions are linear, so at every centre). Exact integers.
 inline bool rect_outside(const SetupTri& t, int x0, int y0, int x1, int y1) {
-    for (int i = 0; i < 3; ++i) {
-        const std::int64_t ex0 = -t.dcdx[i] * 256 * x0, ex1 = -t.dcdx[i] * 256 * x1;
-        const std::int64_t ey0 = t.dcdy[i] * 256 * y0, ey1 = t.dcdy[i] * 256 * y1;
-        const std::int64_t best = t.c[i] + std::max(ex0, ex1) + std::max(ey0, ey1);
-        if (best <= 0) return true;
-    }
-    return false;
+    RectReject r(t);
+    r.set_rows(y0, y1);
+    return r.outside(x0, x1);
 }
 
+// Floor of a / b for b > 0 (exact integers).
+[[gnu::always_inline]] inline std::int64_t floor_div_pos(std::int64_t a, std::int64_t b) {
+    const std::int64_t q = a / b;
+    return q - ((a % b) != 0 && a < 0 ? 1 : 0);
+}
+
+// Shrinks `r` to the rows, then to the columns, in which each edge alone is > 0 at some pixel
+// centre of the rectangle; false when nothing is left. Exact integers (the kernels' own edge
+// values): every pixel centre removed has an edge <= 0 there, so it is not covered, and a kernel
+// run on the result counts and writes exactly what it would on `r`. Thin triangles whose box is
+// cut to a tile often touch only a corner of it (issue #17: the write kernel visited 313 pixels per
+// rectangle for 58 written). An edge e(px, py) = c - sx px + sy py is largest over the columns
+// [x0, x1] at the column of the larger of -sx x0, -sx x1 (linear), and over the rows likewise; a
+// bound is divided out only when it falls strictly inside the rectangle.
+[[gnu::always_inline]] inline bool shrink_rect(const SetupTri& t, PixelRect& r) {
+    for (int i = 0; i < 3; ++i) {
+        const std::int64_t sx = t.dcdx[i] * 256, sy = t.dcdy[i] * 256;
+        const std::int64_t m = t.c[i] - sx * (sx < 0 ? r.x1 : r.x0);    // e <= m + sy py on the row py
+        const std::int64_t top = m + sy * r.y0, bottom = m + sy * r.y1;  // that bound on the first, last row
+        if (top > 0 && bottom > 0) continue;
+        if (top <= 0 && bottom <= 0) return false;
+        if (sy > 0) r.y0 = static_cast<int>(floor_div_pos(-m, sy) + 1);  // top <= 0 < bottom
+        else r.y1 = static_cast<int>(floor_div_pos(m - 1, -sy));          // bottom <= 0 < top
+    }
+    for (int i = 0; i < 3; ++i) {
+        const std::int64_t sx = t.dcdx[i] * 256, sy = t.dcdy[i] * 256;
+        const std::int64_t m = t.c[i] + sy * (sy > 0 ? r.y1 : r.y0);     // e <= m - sx px on the column px
+        const std::int64_t left = m - sx * r.x0, right = m - sx * r.x1;
+        if (left > 0 && right > 0) continue;
+        if (left <= 0 && right <= 0) return false;
+        if (sx > 0) r.x1 = static_cast<int>(floor_div_pos(m - 1, sx));  // right <= 0 < left
+        else r.x0 = static_cast<int>(floor_div_pos(-m, -sx) + 1);       // left <= 0 < right
+    }
+    return true;
+}
 
 }  // namespace raster::detail

@@ -287,3 +287,224 @@ TEST_CASE("one big draw (split front end) and many-tile triangles: any thread co
         }
     }
 }
+
+namespace {
+
+// Covered pixel centres by the definition (pipeline.h, SetupTri): every edge > 0, each evaluated on
+// its own in 64-bit integers, pixel by pixel.
+bool covered_by_definition(const detail::SetupTri& t, int px, int py) {
+    for (int i = 0; i < 3; ++i)
+        if (t.c[i] - t.dcdx[i] * 256 * px + t.dcdy[i] * 256 * py <= 0) return false;
+    return true;
+}
+
+}  // namespace
+
+TEST_CASE("row spans (AVX2 walk, portable division) and shrink_rect == the per-pixel edge test") {
+    // Coverage only: DepthFunc::Always with the mask on over a sentinel that no D24 value equals,
+    // so the pixels a kernel wrote are exactly the pixels it found covered. Targets up to 16384
+    // pixels wide or tall (edge constants near 2^45), thin slivers, long triangles cut to 64 x 64
+    // tiles as the executor does, vertices on pixel centres and corners (ties of the fill rule).
+    raster_test::SplitMix64 rng(0x5ba11u);
+    const int sizes[][2] = {{64, 64}, {203, 131}, {16384, 20}, {20, 16384}, {700, 500}};
+    constexpr std::uint32_t kSentinel = 0xffffffffu;
+    std::uint64_t rects = 0, covered_total = 0, shrunk = 0, emptied = 0;
+    for (const auto& sz : sizes) {
+        const int w = sz[0], h = sz[1];
+        detail::FrontEndParams p{};
+        p.target_width = w;
+        p.target_height = h;
+        p.viewport = raster::Viewport{0, 0, w, h};
+        p.cull_face = raster::CullFace::None;
+        p.front_face = raster::FrontFace::CCW;
+        std::vector<std::uint32_t> a(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), kSentinel), b = a;
+        for (int n = 0; n < 1500; ++n) {
+            std::vector<detail::SetupTri> tris;
+            raster::Float4 v[3];
+            const int flavour = static_cast<int>(rng.below(5));
+            for (auto& x : v) x = raster_test::random_vertex(rng, w, h, flavour);
+            const std::uint32_t shape = rng.below(5);
+            if (shape == 0) {  // sliver: the third vertex near the first
+                v[2] = v[0];
+                v[2].x += rng.uniform(-0.01f, 0.01f) * v[2].w;
+                v[2].y += rng.uniform(-0.01f, 0.01f) * v[2].w;
+            } else if (shape == 1) {  // long and thin: the third vertex near the middle of the first edge
+                v[2] = {(v[0].x + v[1].x) * 0.5f + rng.uniform(-0.02f, 0.02f),
+                        (v[0].y + v[1].y) * 0.5f + rng.uniform(-0.02f, 0.02f), v[0].z, 1.0f};
+                v[0].w = v[1].w = 1.0f;
+            } else if (shape == 2) {
+                // Pixel centres on a coarse grid: every edge runs through pixel centres at steps of
+                // (dx, dy) / gcd, where the fill rule alone decides (edge value 0 before the bias).
+                const int g = 1 << rng.below(4);
+                for (auto& x : v) {
+                    const float px = static_cast<float>(static_cast<int>(rng.below(static_cast<std::uint32_t>(std::min(w, 512)))) / g * g) + 0.5f;
+                    const float py = static_cast<float>(static_cast<int>(rng.below(static_cast<std::uint32_t>(std::min(h, 512)))) / g * g) + 0.5f;
+                    x = {px * (2.0f / static_cast<float>(w)) - 1.0f, py * (2.0f / static_cast<float>(h)) - 1.0f,
+                         rng.uniform(-0.9f, 0.9f), 1.0f};
+                }
+            }
+            detail::setup_triangle(p, v[0], v[1], v[2], 0, tris);
+            for (const auto& t : tris) {
+                detail::PixelRect r{t.x0, t.y0, t.x1, t.y1};
+                const std::uint32_t cut = rng.below(3);
+                if (cut == 0 || static_cast<std::int64_t>(t.x1 - t.x0 + 1) * (t.y1 - t.y0 + 1) > 70000) {
+                    // One 64 x 64 tile of the box, as the executor cuts it.
+                    const int tx = (t.x0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(t.x1 - t.x0 + 1)))) / 64;
+                    const int ty = (t.y0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(t.y1 - t.y0 + 1)))) / 64;
+                    r = {std::max(t.x0, tx * 64), std::max(t.y0, ty * 64), std::min(t.x1, tx * 64 + 63),
+                         std::min(t.y1, ty * 64 + 63)};
+                } else if (cut == 1) {  // a random sub-rectangle of the box
+                    r.x0 = t.x0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(t.x1 - t.x0 + 1)));
+                    r.x1 = r.x0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(t.x1 - r.x0 + 1)));
+                    r.y0 = t.y0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(t.y1 - t.y0 + 1)));
+                    r.y1 = r.y0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(t.y1 - r.y0 + 1)));
+                }
+                std::uint64_t want = 0;
+                for (int py = r.y0; py <= r.y1; ++py)
+                    for (int px = r.x0; px <= r.x1; ++px) want += covered_by_definition(t, px, py) ? 1u : 0u;
+                const std::uint64_t na = detail::raster_rect_portable(t, DepthFormat::D24, DepthFunc::Always, true,
+                                                                      a.data(), w, r.x0, r.y0, r.x1, r.y1, false);
+                const std::uint64_t nb = detail::raster_rect_avx2(t, DepthFormat::D24, DepthFunc::Always, true,
+                                                                  b.data(), w, r.x0, r.y0, r.x1, r.y1, false);
+                CAPTURE(w);
+                CAPTURE(n);
+                CHECK(na == want);
+                CHECK(nb == want);
+                detail::PixelRect s = r;
+                const bool live = detail::shrink_rect(t, s);
+                if (!live) {
+                    ++emptied;
+                    CHECK(want == 0);
+                } else {
+                    CHECK(s.x0 >= r.x0);
+                    CHECK(s.y0 >= r.y0);
+                    CHECK(s.x1 <= r.x1);
+                    CHECK(s.y1 <= r.y1);
+                    CHECK(s.x0 <= s.x1);
+                    CHECK(s.y0 <= s.y1);
+                    if (s.x0 != r.x0 || s.y0 != r.y0 || s.x1 != r.x1 || s.y1 != r.y1) ++shrunk;
+                }
+                // Pixel by pixel: written exactly where covered (and nothing outside the
+                // rectangle), and covered only inside the shrunk rectangle. Restores the sentinel.
+                bool same = true, inside = true;
+                for (int py = r.y0; py <= r.y1; ++py) {
+                    for (int px = r.x0; px <= r.x1; ++px) {
+                        const std::size_t k = static_cast<std::size_t>(py) * static_cast<std::size_t>(w) +
+                                              static_cast<std::size_t>(px);
+                        const bool cov = covered_by_definition(t, px, py);
+                        same = same && (a[k] != kSentinel) == cov && (b[k] != kSentinel) == cov;
+                        inside = inside && (!cov || (live && px >= s.x0 && px <= s.x1 && py >= s.y0 && py <= s.y1));
+                        a[k] = b[k] = kSentinel;
+                    }
+                }
+                CHECK(same);
+                CHECK(inside);
+                ++rects;
+                covered_total += want;
+            }
+        }
+        CHECK(std::all_of(a.begin(), a.end(), [](std::uint32_t x) { return x == kSentinel; }));
+        CHECK(std::all_of(b.begin(), b.end(), [](std::uint32_t x) { return x == kSentinel; }));
+    }
+    MESSAGE("rectangles: " << rects << ", covered pixels: " << covered_total << ", shrunk: " << shrunk
+                           << ", shrunk to nothing: " << emptied);
+    CHECK(rects > 2000);
+    CHECK(covered_total > 100000);
+    CHECK(shrunk > 100);
+    CHECK(emptied > 10);
+}
+
+TEST_CASE("kernels and shrink_rect on made-up edge functions that are -1, 0, 1 or 2 at pixel centres") {
+    // Not triangles from the front end: any three edge functions (the kernels and shrink_rect must
+    // be exact for any), each forced to a value next to the > 0 threshold at a random pixel centre
+    // of the rectangle, with small, medium and large slopes (a 64-bit quotient/remainder walk meets
+    // its wrap-around exactly there). Coverage as in the test above; every depth function on both
+    // kernels too.
+    raster_test::SplitMix64 rng(0xed6e5u);
+    constexpr int W = 96, H = 80;
+    constexpr std::uint32_t kSentinel = 0xffffffffu;
+    std::vector<std::uint32_t> a(W * H, kSentinel), b = a;
+    std::uint64_t covered_total = 0, partial_rows = 0, emptied = 0;
+    const auto slope = [&]() -> std::int64_t {
+        switch (rng.below(4)) {
+            case 0: return static_cast<std::int64_t>(rng.below(9)) - 4;
+            case 1: return static_cast<std::int64_t>(rng.below(601)) - 300;
+            case 2: return static_cast<std::int64_t>(rng.below(1u << 21)) - (1 << 20);
+            default: return 0;
+        }
+    };
+    for (int n = 0; n < 6000; ++n) {
+        detail::PixelRect r;
+        r.x0 = static_cast<int>(rng.below(W));
+        r.x1 = r.x0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(std::min(W - r.x0, rng.chance(50) ? 16 : 96))));
+        r.y0 = static_cast<int>(rng.below(H));
+        r.y1 = r.y0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(H - r.y0)));
+        detail::SetupTri t{};
+        for (int i = 0; i < 3; ++i) {
+            t.dcdx[i] = slope();
+            t.dcdy[i] = slope();
+            const int px = r.x0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(r.x1 - r.x0 + 1)));
+            const int py = r.y0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(r.y1 - r.y0 + 1)));
+            const std::int64_t value = static_cast<std::int64_t>(rng.below(4)) - 1;
+            t.c[i] = value + t.dcdx[i] * 256 * px - t.dcdy[i] * 256 * py;
+        }
+        t.x0 = r.x0;
+        t.y0 = r.y0;
+        t.x1 = r.x1;
+        t.y1 = r.y1;
+        t.z0 = rng.uniform(-0.2f, 1.2f);
+        t.dzdx = rng.uniform(-0.01f, 0.01f);
+        t.dzdy = rng.uniform(-0.01f, 0.01f);
+        std::uint64_t want = 0;
+        for (int py = r.y0; py <= r.y1; ++py) {
+            int row = 0;
+            for (int px = r.x0; px <= r.x1; ++px) row += covered_by_definition(t, px, py) ? 1 : 0;
+            want += static_cast<std::uint64_t>(row);
+            partial_rows += row > 0 && row <= r.x1 - r.x0 ? 1u : 0u;
+        }
+        CAPTURE(n);
+        CHECK(detail::raster_rect_portable(t, DepthFormat::D24, DepthFunc::Always, true, a.data(), W, r.x0, r.y0, r.x1,
+                                           r.y1, false) == want);
+        CHECK(detail::raster_rect_avx2(t, DepthFormat::D24, DepthFunc::Always, true, b.data(), W, r.x0, r.y0, r.x1,
+                                       r.y1, false) == want);
+        detail::PixelRect s = r;
+        const bool live = detail::shrink_rect(t, s);
+        emptied += live ? 0u : 1u;
+        bool same = true, inside = true;
+        for (int py = r.y0; py <= r.y1; ++py) {
+            for (int px = r.x0; px <= r.x1; ++px) {
+                const std::size_t k = static_cast<std::size_t>(py * W + px);
+                const bool cov = covered_by_definition(t, px, py);
+                same = same && (a[k] != kSentinel) == cov && (b[k] != kSentinel) == cov;
+                inside = inside && (!cov || (live && px >= s.x0 && px <= s.x1 && py >= s.y0 && py <= s.y1));
+                a[k] = b[k] = kSentinel;
+            }
+        }
+        CHECK(same);
+        CHECK(inside);
+        if (live) {
+            CHECK(s.x0 >= r.x0);
+            CHECK(s.y0 >= r.y0);
+            CHECK(s.x1 <= r.x1);
+            CHECK(s.y1 <= r.y1);
+        }
+        covered_total += want;
+        // Depth: both kernels, a random format, function and mask, over random stored values.
+        const DepthFormat f = kFormats[rng.below(3)];
+        const DepthFunc func = kFuncs[rng.below(8)];
+        const bool write = rng.chance(50);
+        std::vector<std::uint32_t> c(W * H), d;
+        for (auto& x : c) x = random_stored(rng, f, std::clamp(t.z0, 0.0f, 1.0f));
+        d = c;
+        CHECK(detail::raster_rect_portable(t, f, func, write, c.data(), W, r.x0, r.y0, r.x1, r.y1, false) ==
+              detail::raster_rect_avx2(t, f, func, write, d.data(), W, r.x0, r.y0, r.x1, r.y1, false));
+        CHECK(c == d);
+    }
+    CHECK(std::all_of(a.begin(), a.end(), [](std::uint32_t x) { return x == kSentinel; }));
+    CHECK(std::all_of(b.begin(), b.end(), [](std::uint32_t x) { return x == kSentinel; }));
+    MESSAGE("covered pixels: " << covered_total << ", rows partly covered: " << partial_rows
+                               << ", rectangles shrunk to nothing: " << emptied);
+    CHECK(covered_total > 100000);
+    CHECK(partial_rows > 10000);
+    CHECK(emptied > 100);
+}
