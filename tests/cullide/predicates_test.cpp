@@ -142,6 +142,43 @@ TEST_CASE("orient3d is exact for exactly coplanar integer points and for repeate
     CHECK(wrong == 0);
 }
 
+TEST_CASE("orient3d is exact on coarse grids, on both sides of the small-span stage's 16-bit limit") {
+    // Integer points scaled by 2^e: a, b, c in [-2^(g-1), 2^(g-1)], d on their plane (integer
+    // combination) or one grid unit off it. The nine differences span about g + 3 bits, so g = 10..22
+    // puts them on both sides of the 16-bit limit under which orient3d's own evaluation is exact,
+    // and far enough past it (products of three differences above 2^53 units) that a stage taken
+    // past its limit gives wrong signs here (checked with a limit of 22 bits).
+    Rng rng{24};
+    long wrong = 0, zeros = 0, nonzeros = 0;
+    for (int n = 0; n < 91000; ++n) {
+        const int g = 10 + n % 13;
+        const int lim = 1 << (g - 1);
+        const double unit = std::ldexp(1.0, rng.range(-60, 60));
+        std::int64_t p[3][3];
+        for (auto& q : p)
+            for (auto& x : q) x = rng.range(-lim, lim);
+        const int i = rng.range(-3, 3), j = rng.range(-3, 3);
+        std::int64_t q[3];
+        for (int k = 0; k < 3; ++k) q[k] = p[0][k] + i * (p[1][k] - p[0][k]) + j * (p[2][k] - p[0][k]);
+        if (n % 3 == 1) q[rng.range(0, 2)] += rng.coin() ? 1 : -1;  // one unit off the plane
+        auto vec = [&](const std::int64_t* v) {
+            return Vec3{double(v[0]) * unit, double(v[1]) * unit, double(v[2]) * unit};
+        };
+        const Vec3 a = vec(p[0]), b = vec(p[1]), c = vec(p[2]), d = vec(q);
+        const auto exact_before = cullide::predicate_stats().orient3d_exact;
+        const int got = cullide::orient3d(a, b, c, d);
+        const int want = cullide::test::rational_orient3d(a, b, c, d);
+        wrong += got != want;
+        if (got != want && wrong < 5) FAIL_CHECK("orient3d wrong at case " << n << " (g = " << g << ")");
+        (want == 0 ? zeros : nonzeros) += 1;
+        // Spans of at most 13 bits (g = 10): a coplanar point never reaches the expansion arithmetic.
+        if (g == 10 && want == 0) CHECK(cullide::predicate_stats().orient3d_exact == exact_before);
+    }
+    CHECK(wrong == 0);
+    CHECK(zeros > 10000);
+    CHECK(nonzeros > 10000);
+}
+
 TEST_CASE("both predicates are exact across the whole stated range, magnitudes 2^-300 to 2^300 mixed") {
     Rng rng{24};
     long wrong = 0;

@@ -42,7 +42,9 @@ inline constexpr double kPredicateMinAbs = 0x1p-300;
 // component `drop` of (b - a) x (c - a).
 [[nodiscard]] int orient2d_drop(const Vec3& a, const Vec3& b, const Vec3& c, int drop);
 
-// Counters of how often the exact fallback ran (per thread; for tests and benchmarks only).
+// Counters of how often the exact fallback's expansion arithmetic ran (per thread; for tests and
+// benchmarks only). orient3d's exact small-span stage (predicates.cpp), which settles coplanar points
+// of coarse grids without it, is not counted.
 struct PredicateStats {
     unsigned long long orient2d_exact = 0;
     unsigned long long orient3d_exact = 0;
