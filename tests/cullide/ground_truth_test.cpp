@@ -161,7 +161,7 @@ TEST_CASE("float_down and float_up give the nearest floats below and above, infi
         if (!std::isinf(u)) REQUIRE(static_cast<double>(std::nextafter(u, -kInf)) < x);
         if (static_cast<double>(static_cast<float>(x)) == x) REQUIRE((d == u && d == static_cast<float>(x)));
     };
-    const double flt_max = std::numeric_limits<float>::max();
+    const auto flt_max = static_cast<double>(std::numeric_limits<float>::max());
     for (double x : {0.0, -0.0, 1.0, -1.0, 0.1, -0.1, 1e-300, -1e-300, 1e-45, -1e-45, 1e300, -1e300, flt_max,
                      -flt_max, std::nextafter(flt_max, 1e300), -std::nextafter(flt_max, 1e300), 0x1p-149, 0x1.8p-149})
         check(x);
@@ -184,7 +184,7 @@ TEST_CASE("float_box(lo, hi) rounds every bound as float_down and float_up do, t
     using cullide::detail::float_down;
     using cullide::detail::float_up;
     test::Rng rng(12);
-    const double flt_max = std::numeric_limits<float>::max();
+    const auto flt_max = static_cast<double>(std::numeric_limits<float>::max());
     const double edges[] = {0.0, -0.0, 1e-300, -1e-300, 0x1p-149, -0x1.8p-149, flt_max, -flt_max,
                             std::nextafter(flt_max, 1e300), -std::nextafter(flt_max, 1e300), 1e300, -1e300, 0.1, -0.1};
     const auto draw = [&]() -> double {
@@ -218,7 +218,7 @@ TEST_CASE("float_box_round_down under a RoundDownScope gives float_box's bits, a
     using cullide::detail::float_down;
     using cullide::detail::float_up;
     test::Rng rng(13);
-    const double flt_max = std::numeric_limits<float>::max();
+    const auto flt_max = static_cast<double>(std::numeric_limits<float>::max());
     const double edges[] = {0.0, -0.0, 1e-300, -1e-300, 0x1p-149, -0x1.8p-149, 0x1p-150, -0x1p-150, 1e-320, -1e-320,
                             flt_max, -flt_max, std::nextafter(flt_max, 1e300), -std::nextafter(flt_max, 1e300), 1e300,
                             -1e300, 0.1, -0.1, 1.0, -1.0};
