@@ -138,6 +138,42 @@ struct FloatBox {
     f.hi[2] = -d[5];
     return f;
 }
+
+// The same bits as float_box_sse2 by the conversion's own rounding: float_down(x) is x rounded
+// toward -infinity (IEEE 754 directed rounding: beyond the float range it gives -infinity below and
+// the largest float above, as float_down does; a tiny x gives 0 or -denorm_min, again as float_down;
+// signed zeros stay) and float_up(x) is -float_down(-x). So with MXCSR set to round down (a
+// RoundDownScope alive on this thread), three CVTPD2PS and two sign flips replace float_down's
+// clamp, compare and one-step correction: 9 instructions a box instead of about 40, in the
+// ground truth's scan, where the rounding was a third of breaking's per-triangle instructions.
+[[nodiscard]] inline FloatBox float_box_round_down(__m128d lo_xy, __m128d lo_z, __m128d hi_xy, __m128d hi_z) {
+    const __m128d neg = _mm_set1_pd(-0.0);
+    const __m128d nhi_xy = _mm_xor_pd(hi_xy, neg), nhi_z = _mm_xor_pd(hi_z, neg);
+    // lo.x, lo.y, lo.z, -hi.x rounded down; then -hi.y, -hi.z rounded down; the hi lanes negated back.
+    const __m128 first = _mm_movelh_ps(_mm_cvtpd_ps(lo_xy), _mm_cvtpd_ps(_mm_unpacklo_pd(lo_z, nhi_xy)));
+    const __m128 second = _mm_cvtpd_ps(_mm_shuffle_pd(nhi_xy, nhi_z, 1));
+    static_assert(sizeof(FloatBox) == 6 * sizeof(float));  // lo then hi, no padding
+    FloatBox f;
+    auto* const bounds = reinterpret_cast<float*>(&f);  // the whole object: no store past a member array
+    _mm_storeu_ps(bounds, _mm_xor_ps(first, _mm_castsi128_ps(_mm_set_epi32(INT32_MIN, 0, 0, 0))));
+    _mm_storel_pi(reinterpret_cast<__m64*>(bounds + 4), _mm_xor_ps(second, _mm_set1_ps(-0.0f)));
+    return f;
+}
+
+// MXCSR set to round toward -infinity for float_box_round_down while alive, the caller's MXCSR
+// restored after (MXCSR is per thread: make one inside each parallel job). The mode is set whole
+// (every exception masked, no flush-to-zero, no denormals-are-zero), so a caller's FTZ or DAZ
+// cannot change the bits.
+class RoundDownScope {
+   public:
+    RoundDownScope() : saved_(_mm_getcsr()) { _mm_setcsr(0x1f80u | 0x2000u); }
+    ~RoundDownScope() { _mm_setcsr(saved_); }
+    RoundDownScope(const RoundDownScope&) = delete;
+    RoundDownScope& operator=(const RoundDownScope&) = delete;
+
+   private:
+    unsigned saved_;
+};
 #endif
 
 // float_box of the box [lo, hi], every bound as float_down / float_up give it (the same bits; x86-64:

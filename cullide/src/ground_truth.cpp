@@ -196,6 +196,9 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
             Aabb all{{HUGE_VAL, HUGE_VAL, HUGE_VAL}, {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}};
             const Vec3* const pos = m.positions.data();
             const Tri* const tris = m.triangles.data();
+#if defined(__SSE2__)
+            const detail::RoundDownScope round_down;  // for float_box_round_down; this job's thread only
+#endif
             for (std::size_t b0 = job.first; b0 < job.last; b0 += detail::kBoxBlock) {
                 const std::size_t b1 = std::min(job.last, b0 + detail::kBoxBlock);
 #if defined(__SSE2__)
@@ -228,7 +231,7 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
                     _mm_storeu_pd(&box.hi.x, hi_xy);
                     _mm_store_sd(&box.hi.z, hi_z);
                     std::construct_at(box_out + t, box);
-                    std::construct_at(float_out + t, detail::float_box_sse2(lo_xy, lo_z, hi_xy, hi_z));
+                    std::construct_at(float_out + t, detail::float_box_round_down(lo_xy, lo_z, hi_xy, hi_z));
                 }
                 Aabb block;
                 _mm_storeu_pd(&block.lo.x, blo_xy);

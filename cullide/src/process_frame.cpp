@@ -6,6 +6,10 @@
 #include <chrono>
 #include <memory>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "emulator_device.h"
 #include "parallel.h"
 #include "spatialhash/broad_phase.h"
@@ -201,6 +205,26 @@ std::vector<Aabb> kept_vertex_bounds(std::span<const Mesh> objects, std::span<co
     std::vector<Aabb> job_box(jobs.size());
     detail::parallel_chunks(threads, jobs.size(), [&](std::size_t j) {
         const Vec3* const pos = objects[active[jobs[j].k]].positions.data();
+#if defined(__SSE2__)
+        // x and y in the two lanes of one register, z alone: std::min(lo, p) is (p < lo ? p : lo),
+        // _mm_min_pd(p, lo), which also keeps lo for a NaN p and a NaN lo (MINPD returns its second
+        // operand then); std::max likewise. The same bits as the scalar loop in 4 operations a vertex.
+        __m128d lo_xy = _mm_loadu_pd(&pos[jobs[j].first].x), lo_z = _mm_load_sd(&pos[jobs[j].first].z);
+        __m128d hi_xy = lo_xy, hi_z = lo_z;
+        for (std::size_t v = jobs[j].first; v < jobs[j].last; ++v) {
+            const __m128d xy = _mm_loadu_pd(&pos[v].x), z = _mm_load_sd(&pos[v].z);
+            lo_xy = _mm_min_pd(xy, lo_xy);
+            lo_z = _mm_min_sd(z, lo_z);
+            hi_xy = _mm_max_pd(xy, hi_xy);
+            hi_z = _mm_max_sd(z, hi_z);
+        }
+        Aabb box;
+        _mm_storeu_pd(&box.lo.x, lo_xy);
+        _mm_store_sd(&box.lo.z, lo_z);
+        _mm_storeu_pd(&box.hi.x, hi_xy);
+        _mm_store_sd(&box.hi.z, hi_z);
+        job_box[j] = box;
+#else
         // Six doubles in registers.
         double x0 = pos[jobs[j].first].x, y0 = pos[jobs[j].first].y, z0 = pos[jobs[j].first].z;
         double x1 = x0, y1 = y0, z1 = z0;
@@ -213,6 +237,7 @@ std::vector<Aabb> kept_vertex_bounds(std::span<const Mesh> objects, std::span<co
             z1 = std::max(z1, pos[v].z);
         }
         job_box[j] = {{x0, y0, z0}, {x1, y1, z1}};
+#endif
     });
     std::vector<Aabb> boxes(active.size());
     for (std::size_t j = 0; j < jobs.size(); ++j) {

@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -160,7 +161,7 @@ TEST_CASE("float_down and float_up give the nearest floats below and above, infi
         if (!std::isinf(u)) REQUIRE(static_cast<double>(std::nextafter(u, -kInf)) < x);
         if (static_cast<double>(static_cast<float>(x)) == x) REQUIRE((d == u && d == static_cast<float>(x)));
     };
-    const double flt_max = std::numeric_limits<float>::max();
+    const auto flt_max = static_cast<double>(std::numeric_limits<float>::max());
     for (double x : {0.0, -0.0, 1.0, -1.0, 0.1, -0.1, 1e-300, -1e-300, 1e-45, -1e-45, 1e300, -1e300, flt_max,
                      -flt_max, std::nextafter(flt_max, 1e300), -std::nextafter(flt_max, 1e300), 0x1p-149, 0x1.8p-149})
         check(x);
@@ -183,7 +184,7 @@ TEST_CASE("float_box(lo, hi) rounds every bound as float_down and float_up do, t
     using cullide::detail::float_down;
     using cullide::detail::float_up;
     test::Rng rng(12);
-    const double flt_max = std::numeric_limits<float>::max();
+    const auto flt_max = static_cast<double>(std::numeric_limits<float>::max());
     const double edges[] = {0.0, -0.0, 1e-300, -1e-300, 0x1p-149, -0x1.8p-149, flt_max, -flt_max,
                             std::nextafter(flt_max, 1e300), -std::nextafter(flt_max, 1e300), 1e300, -1e300, 0.1, -0.1};
     const auto draw = [&]() -> double {
@@ -208,6 +209,64 @@ TEST_CASE("float_box(lo, hi) rounds every bound as float_down and float_up do, t
     }
     CHECK(differ == 0);
 }
+
+#if defined(__SSE2__)
+TEST_CASE("float_box_round_down under a RoundDownScope gives float_box's bits, and the scope restores MXCSR") {
+    // The scan converts with MXCSR rounding toward -infinity instead of float_down's correction: the
+    // same bits for every finite double (the range edges, subnormals, signed zeros, beyond the float
+    // range), whatever flush-to-zero or denormals-are-zero mode the caller runs in.
+    using cullide::detail::float_down;
+    using cullide::detail::float_up;
+    test::Rng rng(13);
+    const auto flt_max = static_cast<double>(std::numeric_limits<float>::max());
+    const double edges[] = {0.0, -0.0, 1e-300, -1e-300, 0x1p-149, -0x1.8p-149, 0x1p-150, -0x1p-150, 1e-320, -1e-320,
+                            flt_max, -flt_max, std::nextafter(flt_max, 1e300), -std::nextafter(flt_max, 1e300), 1e300,
+                            -1e300, 0.1, -0.1, 1.0, -1.0};
+    const auto draw = [&]() -> double {
+        switch (rng.below(3)) {
+            case 0: return edges[rng.below(std::size(edges))];
+            case 1: {
+                const double x = std::bit_cast<double>(rng.next());
+                return std::isfinite(x) ? x : 1.5;
+            }
+            default: return std::ldexp(rng.sym(), static_cast<int>(rng.below(320)) - 160);
+        }
+    };
+    // The boxes and float_down's bits first, in the caller's mode.
+    std::vector<std::array<double, 6>> boxes(100000);
+    std::vector<std::array<float, 6>> want(boxes.size());
+    for (std::size_t i = 0; i < boxes.size(); ++i)
+        for (int k = 0; k < 3; ++k) {
+            const auto lo = static_cast<std::size_t>(k), hi = lo + 3;
+            boxes[i][lo] = draw();
+            boxes[i][hi] = draw();
+            want[i][lo] = float_down(boxes[i][lo]);
+            want[i][hi] = float_up(boxes[i][hi]);
+        }
+    const unsigned before = _mm_getcsr();
+    std::uint64_t differ = 0;
+    for (const unsigned caller : {before, before | 0x8040u}) {  // as is; with flush-to-zero and DAZ set
+        _mm_setcsr(caller);
+        for (std::size_t i = 0; i < boxes.size(); ++i) {
+            const std::array<double, 6>& b = boxes[i];
+            cullide::detail::FloatBox f;
+            {
+                const cullide::detail::RoundDownScope scope;
+                f = cullide::detail::float_box_round_down(_mm_set_pd(b[1], b[0]), _mm_set_sd(b[2]), _mm_set_pd(b[4], b[3]),
+                                                          _mm_set_sd(b[5]));
+            }
+            for (std::size_t k = 0; k < 3; ++k) {
+                differ += std::bit_cast<std::uint32_t>(f.lo[k]) != std::bit_cast<std::uint32_t>(want[i][k]) ? 1 : 0;
+                differ += std::bit_cast<std::uint32_t>(f.hi[k]) != std::bit_cast<std::uint32_t>(want[i][k + 3]) ? 1 : 0;
+            }
+        }
+        const unsigned after = _mm_getcsr();
+        _mm_setcsr(before);
+        CHECK(after == caller);  // restored whole
+    }
+    CHECK(differ == 0);
+}
+#endif
 
 TEST_CASE("the triangle sweep gives the set sweep's pairs and counts where floats cannot hold the boxes") {
     // Coordinates a tiny step (2^-30, far below a float's spacing near 8) off the dyadic grid, so
