@@ -321,12 +321,48 @@ void bin(const SetupDraws& setup, std::size_t n_draws, const Tiles& tiles, int t
     });
 }
 
+// What shade() needs of one draw, gathered once per batch (draw_infos): a bin reference then
+// reads this record and its triangle instead of a chain of loads through the command, the query
+// tables and the setup lists (the shade loop's time looked like memory stalls, perf, issue #17).
+struct DrawInfo {
+    const detail::SetupTri* tris;  // the draw's GL-exact setup list (shared or its own); unused for exact bounds
+    detail::RectKernel kernel;     // GL-exact: the kernel for its depth state (hiz as the batch)
+    std::uint32_t query;           // the active query, or kNoQuery
+    bool exact_bounds;             // RasterMode::ExactBounds
+    bool write;                    // depth mask on
+    bool any_only;                 // an any-samples query with the mask off (see shade)
+};
+
+void draw_infos(const CommandBatch& batch, const Draws& draws, const SetupDraws& setup, DepthFormat format,
+                bool allow_simd, bool hiz,
+                std::vector<DrawInfo>& out) {
+    const auto& cmds = batch.commands();
+    const auto& query_kinds = batch.query_kinds();
+    out.resize(draws.cmds.size());
+    for (std::size_t d = 0; d < draws.cmds.size(); ++d) {
+        const std::uint32_t cmd = draws.cmds[d];
+        const Command& c = cmds[cmd];
+        DrawInfo& info = out[d];
+        info.query = draws.cmd_query[cmd];
+        info.exact_bounds = c.state.mode == RasterMode::ExactBounds;
+        info.write = c.state.depth_write;
+        info.any_only = info.query != kNoQuery && !c.state.depth_write &&
+                        query_kinds[info.query] == QueryKind::AnySamplesPassed;
+        info.tris = info.exact_bounds ? nullptr : setup.tris[setup.src[d]].data();
+        info.kernel = info.exact_bounds
+                          ? nullptr
+                          : detail::select_rect_kernel({format, c.state.depth_func, c.state.depth_write},
+                                                       allow_simd, hiz);
+    }
+}
+
 // What every tile's back end reads (shared, read-only but for the depth values of its own tile
 // and the any-samples flags).
 struct ShadeContext {
     const CommandBatch& batch;
     const Draws& draws;
     const SetupDraws& setup;
+    const DrawInfo* info;  // per draw (draw_infos)
     detail::DepthRows depth;
     int width, height;
     DepthFormat format;
@@ -346,7 +382,6 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
         return detail::PixelRect{std::max(x0, bx0), std::max(y0, by0), std::min(x1, bx1), std::min(y1, by1)};
     };
     const auto& cmds = ctx.batch.commands();
-    const auto& query_kinds = ctx.batch.query_kinds();
     detail::HizTile* const hiz =
         ctx.hiz ? &ctx.hiz_tiles[static_cast<std::size_t>(ty) * static_cast<std::size_t>((ctx.width + kTileSize - 1) / kTileSize) +
                                  static_cast<std::size_t>(tx)]
@@ -356,15 +391,13 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
         hiz->valid = 0;  // bounds are read from the buffer afresh in every batch
     }
     bool wrote = false;
-    std::uint32_t kernel_cmd = kNoQuery;  // the command `kernel` was selected for
-    detail::RectKernel kernel = nullptr;
     for (const Ref& r : bin) {
-        const std::uint32_t cmd = ctx.draws.cmds[r.draw];
-        const Command& c = cmds[cmd];
-        const detail::DepthState depth_state{ctx.format, c.state.depth_func, c.state.depth_write};
-        const std::uint32_t q = ctx.draws.cmd_query[cmd];
+        const DrawInfo& info = ctx.info[r.draw];
+        const std::uint32_t q = info.query;
         std::uint64_t passed;
-        if (c.state.mode == RasterMode::ExactBounds) {
+        if (info.exact_bounds) {
+            const Command& c = cmds[ctx.draws.cmds[r.draw]];
+            const detail::DepthState depth_state{ctx.format, c.state.depth_func, c.state.depth_write};
             if (c.state.depth_write) wrote = true;
             const auto& tri = ctx.setup.bounds[r.draw][r.tri];
             passed = detail::bounds_rect(tri, ctx.setup.pool[r.draw].data(), depth_state, ctx.depth,
@@ -374,12 +407,12 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
             // Any-samples query with the mask off: once this query has a passing sample (in this
             // tile, or in any tile: the flag), further draws in it change nothing; the kernel also
             // stops at its first passing row. The boolean is the same whatever the schedule.
-            const bool any_only = q != kNoQuery && !c.state.depth_write && query_kinds[q] == QueryKind::AnySamplesPassed;
+            const bool any_only = info.any_only;
             if (any_only && ((!counts.empty() && counts.back().first == q) ||
                              ctx.answered[q].load(std::memory_order_relaxed)))
                 continue;
-            if (c.state.depth_write) wrote = true;
-            const auto& tri = ctx.setup.tris[ctx.setup.src[r.draw]][r.tri];
+            if (info.write) wrote = true;
+            const detail::SetupTri& tri = info.tris[r.tri];
             detail::PixelRect rect = clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1);
             // A triangle over several tiles: its part of this tile may be much smaller than the
             // box's (a thin triangle through a corner). Within one tile the box is already tight.
@@ -387,11 +420,7 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
             if ((rect.x0 != tri.x0 || rect.y0 != tri.y0 || rect.x1 != tri.x1 || rect.y1 != tri.y1) &&
                 (rect.x1 - rect.x0 + 1) * (rect.y1 - rect.y0 + 1) >= kShrinkMinArea && !detail::shrink_rect(tri, rect))
                 continue;
-            if (cmd != kernel_cmd) {  // consecutive references of a bin are mostly of one draw
-                kernel = detail::select_rect_kernel(depth_state, ctx.allow_simd, hiz != nullptr);
-                kernel_cmd = cmd;
-            }
-            passed = kernel(tri, ctx.depth, rect, hiz, any_only);
+            passed = info.kernel(tri, ctx.depth, rect, hiz, any_only);
             if (any_only && passed != 0) ctx.answered[q].store(true, std::memory_order_relaxed);
         }
         if (q == kNoQuery || passed == 0) continue;
@@ -424,6 +453,7 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
         std::vector<std::atomic<bool>> answered;
         std::vector<detail::HizTile> hiz_tiles;
         SetupIndex setup_index;
+        std::vector<DrawInfo> infos;
     };
     thread_local Scratch scratch;
     Draws& draw_list = scratch.draw_list;
@@ -444,7 +474,8 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
     static_assert(kTileSize == detail::kHizTile, "HizTile holds the 8 x 8 blocks of one executor tile");
     const bool hiz = options.hierarchical_z && hiz_allowed_by_environment() && target.format() != DepthFormat::D32F;
     if (hiz && scratch.hiz_tiles.size() < tiles.count()) scratch.hiz_tiles.resize(tiles.count());
-    const ShadeContext ctx{batch,          draw_list,       setup,
+    draw_infos(batch, draw_list, setup, target.format(), options.allow_simd, hiz, scratch.infos);
+    const ShadeContext ctx{batch,          draw_list,       setup,          scratch.infos.data(),
                            {target.mutable_values().data(), target.width()},
                            target.width(), target.height(), target.format(),
                            options.allow_simd, hiz, scratch.hiz_tiles.data(),

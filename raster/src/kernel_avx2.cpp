@@ -220,16 +220,24 @@ std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, b
         // functions in 32-bit lanes, when every value they take over the rectangle (padded to whole
         // chunks of 8) fits: |e| <= |e(rx0, ry0)| + |x step| * (width + 7) + |y step| * (height - 1)
         // < 2^31. Exact: the same integers as the 64-bit span solver, without its divisions.
+        // Setup's per-triangle flag (SetupTri::fits32) covers every rectangle inside the box; the
+        // rectangle's own bound is computed only for triangles without it.
         std::int64_t e_row[3], sx[3], sy[3];
-        bool fits = true;
         #pragma GCC unroll 3
         for (int i = 0; i < 3; ++i) {
             e_row[i] = edge_at(t, i, rx0, ry0);
             sx[i] = t.dcdx[i] * 256;
             sy[i] = t.dcdy[i] * 256;
-            const std::int64_t bound =
-                std::abs(e_row[i]) + std::abs(sx[i]) * (rx1 - rx0 + 8) + std::abs(sy[i]) * (ry1 - ry0);
-            fits = fits && bound < (std::int64_t{1} << 31);
+        }
+        bool fits = t.fits32;
+        if (!fits) {
+            fits = true;
+            #pragma GCC unroll 3
+            for (int i = 0; i < 3; ++i) {
+                const std::int64_t bound =
+                    std::abs(e_row[i]) + std::abs(sx[i]) * (rx1 - rx0 + 8) + std::abs(sy[i]) * (ry1 - ry0);
+                fits = fits && bound < (std::int64_t{1} << 31);
+            }
         }
         if (fits) {
             return rx1 - rx0 < 8 ? narrow_rows<1, Fmt, F, Write>(t, depth, rect, e_row, sx, sy, stop_at_first)

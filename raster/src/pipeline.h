@@ -36,6 +36,10 @@ struct SetupTri {
     int x0, y0, x1, y1;  // inclusive pixel bounding box, already inside the target
     float z0, dzdx, dzdy;  // depth plane: z(px, py) = fma(dzdy, py, fma(dzdx, px, z0))
     std::uint32_t draw;  // index of the draw command in the batch
+    // Set by setup (false is always safe): every edge value at a pixel of the box widened by 7
+    // columns to the right, [x0, x1 + 7] x [y0, y1], fits in 32 bits, so the AVX2 kernel's narrow
+    // path may run on any rectangle inside the box without its own bound (triangle_setup.cpp).
+    bool fits32;
 };
 
 struct FrontEndParams {

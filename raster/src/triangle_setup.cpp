@@ -204,6 +204,16 @@ void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const 
     t.dzdx = dadx;
     t.dzdy = dady;
     t.draw = draw;
+    // SetupTri::fits32 from the snapped extents (two products; an exact bound over the box's
+    // corners cost about 40 instructions per triangle, more than the kernel saved: callgrind,
+    // cylinders frame). Edge i at the pixel centre (px, py) is
+    // dcdx (x_i - 256 px) - dcdy (y_i - 256 py) (+1), with |dcdx| <= span_y, |dcdy| <= span_x and,
+    // for px in [x0, x1 + 7], py in [y0, y1] (the box rounding above, clamping only narrows it):
+    // |x_i - 256 px| <= span_x + 1791, |y_i - 256 py| <= span_y + 255.
+    {
+        const int64_t span_x = maxx - minx, span_y = maxy - miny;
+        t.fits32 = span_y * (span_x + 2048) + span_x * (span_y + 256) + 1 < (int64_t{1} << 31);
+    }
     out.push_back(t);
 }
 

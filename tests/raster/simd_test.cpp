@@ -508,3 +508,47 @@ TEST_CASE("kernels and shrink_rect on made-up edge functions that are -1, 0, 1 o
     CHECK(partial_rows > 10000);
     CHECK(emptied > 100);
 }
+
+// SetupTri::fits32 lets the AVX2 narrow path skip its per-rectangle 32-bit bound: when setup sets
+// it, every edge value at a pixel centre of [x0, x1 + 7] x [y0, y1] must fit in 32 bits. Edges are
+// linear, so the four corners carry the extremes. Triangles of every size (targets up to 16384 px,
+// a vertex far outside, so clipping and the flag's false side both occur).
+TEST_CASE("SetupTri::fits32 holds: every edge value over the box widened by 7 columns fits in 32 bits") {
+    raster_test::SplitMix64 rng(0xf175u);
+    std::uint64_t flagged = 0, unflagged = 0;
+    for (const int side : {64, 1024, 16384}) {
+        detail::FrontEndParams p{};
+        p.target_width = side;
+        p.target_height = side;
+        p.viewport = raster::Viewport{0, 0, side, side};
+        p.cull_face = raster::CullFace::None;
+        p.front_face = raster::FrontFace::CCW;
+        for (int n = 0; n < 3000; ++n) {
+            raster::Float4 v[3];
+            const float spread = rng.chance(50) ? rng.uniform(0.0f, 0.05f) : rng.uniform(0.0f, 3.0f);
+            const float cx = rng.uniform(-1.0f, 1.0f), cy = rng.uniform(-1.0f, 1.0f);
+            for (auto& x : v)
+                x = {cx + rng.uniform(-spread, spread), cy + rng.uniform(-spread, spread), rng.uniform(-0.9f, 0.9f), 1.0f};
+            std::vector<detail::SetupTri> tris;
+            detail::setup_triangle(p, v[0], v[1], v[2], 0, tris);
+            for (const auto& t : tris) {
+                if (!t.fits32) {
+                    ++unflagged;
+                    continue;
+                }
+                ++flagged;
+                for (int i = 0; i < 3; ++i)
+                    for (const int px : {t.x0, t.x1 + 7})
+                        for (const int py : {t.y0, t.y1}) {
+                            const std::int64_t e = t.c[i] - t.dcdx[i] * 256 * px + t.dcdy[i] * 256 * py;
+                            CAPTURE(n);
+                            CHECK(e < (std::int64_t{1} << 31));
+                            CHECK(e >= -(std::int64_t{1} << 31));
+                        }
+            }
+        }
+    }
+    // Both sides of the flag were exercised.
+    CHECK(flagged > 1000);
+    CHECK(unflagged > 100);
+}
