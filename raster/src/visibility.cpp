@@ -21,16 +21,19 @@ namespace {
 // views still split into several tasks (the answer does not depend on it: every pixel's minima and
 // every fragment's test are the same whichever tile holds them).
 //
-// One tile holding the whole target for one thread on targets up to kOneTileMax pixels a side: tiles
-// are then only overhead (each triangle's Ref pushed per tile it overlaps, its box cut to each tile,
-// the tasks); the answer is the same (see above). With two or more threads R-CULLIDE's 32^2 views
-// keep their four 16-pixel tiles: on a quiet machine they beat one tile (cylinders 6.4-6.8 against
-// 6.8-7.0 ms per frame, tori 36.0-36.3 against 36.8-37.1, 2 threads, load 1.7).
+// One tile holding the whole target, whatever the thread count, on targets up to kOneTileMax pixels
+// a side: tiles are then only overhead (each triangle's Ref pushed per tile it overlaps, its box cut to
+// each tile, the tasks); the answer is the same (see above), and the front end still runs its items
+// on every thread. Session 6 kept four 16-pixel tiles for R-CULLIDE's 32^2 views with two threads
+// (faster then, at load 1.7); after the exact stage got 1.5-3x faster they made two threads slower
+// than one on every scene. One tile, 2 threads, interleaved with the four tiles, two rounds, quiet
+// machine (load ~1.2): cylinders 4.99-5.01 against 5.38-5.75 ms per frame, breaking 18.5-18.7
+// against 20.3-20.4, leaves 8.65-8.78 against 9.28-9.32, cloth 2.38 against 2.48-2.56.
 constexpr int kOneTileMax = 128;
-int tile_side(int width, int height, int threads) {
+int tile_side(int width, int height) {
     const int m = std::max(width, height);
-    if (threads == 1 && m <= kOneTileMax) return m;
-    return m <= 128 ? 16 : m <= 256 ? 32 : 64;
+    if (m <= kOneTileMax) return m;
+    return m <= 256 ? 32 : 64;
 }
 // Settling tiles from depth bounds (shade) pays where triangles are large: their pixels are the cost,
 // and a 16-pixel tile skipped saves many. Where the triangles' boxes average fewer than
@@ -356,7 +359,7 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
     }
     const bool settle = count > 0 && area >= kSettleMinArea * count;
     if (settle) s.depth_bounds(format, items.size());
-    const int side = settle ? kSettleTile : tile_side(width, height, threads);
+    const int side = settle ? kSettleTile : tile_side(width, height);
     const TileGrid grid{side, (width + side - 1) / side, (height + side - 1) / side};
     s.bin(items, grid, settle);
     const std::size_t pixels = grid.count() * grid.pixels();
