@@ -103,6 +103,17 @@ struct FloatBox {
 }
 
 #if defined(__SSE2__)
+// The box whose lows are (lo_xy, lo_z) and highs (hi_xy, hi_z), x and y in the two lanes, z in the
+// low lane: the layout of the SSE2 min/max loops (the ground truth's scan, the auto plan's boxes).
+[[nodiscard]] inline Aabb aabb_sse2(__m128d lo_xy, __m128d lo_z, __m128d hi_xy, __m128d hi_z) {
+    Aabb box;
+    _mm_storeu_pd(&box.lo.x, lo_xy);
+    _mm_store_sd(&box.lo.z, lo_z);
+    _mm_storeu_pd(&box.hi.x, hi_xy);
+    _mm_store_sd(&box.hi.z, hi_z);
+    return box;
+}
+
 // float_box of the box whose lows are (lo_xy, lo_z) and highs (hi_xy, hi_z), x and y in the two
 // lanes, z in the low lane: the scan hands its SSE2 registers over as they are.
 [[nodiscard]] inline FloatBox float_box_sse2(__m128d lo_xy, __m128d lo_z, __m128d hi_xy, __m128d hi_z) {

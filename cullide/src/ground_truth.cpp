@@ -225,19 +225,10 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
                     blo_z = _mm_min_sd(lo_z, blo_z);
                     bhi_xy = _mm_max_pd(hi_xy, bhi_xy);
                     bhi_z = _mm_max_sd(hi_z, bhi_z);
-                    Aabb box;
-                    _mm_storeu_pd(&box.lo.x, lo_xy);
-                    _mm_store_sd(&box.lo.z, lo_z);
-                    _mm_storeu_pd(&box.hi.x, hi_xy);
-                    _mm_store_sd(&box.hi.z, hi_z);
-                    std::construct_at(box_out + t, box);
+                    std::construct_at(box_out + t, detail::aabb_sse2(lo_xy, lo_z, hi_xy, hi_z));
                     std::construct_at(float_out + t, detail::float_box_round_down(lo_xy, lo_z, hi_xy, hi_z));
                 }
-                Aabb block;
-                _mm_storeu_pd(&block.lo.x, blo_xy);
-                _mm_store_sd(&block.lo.z, blo_z);
-                _mm_storeu_pd(&block.hi.x, bhi_xy);
-                _mm_store_sd(&block.hi.z, bhi_z);
+                const Aabb block = detail::aabb_sse2(blo_xy, blo_z, bhi_xy, bhi_z);
 #else
                 double bx0 = HUGE_VAL, by0 = HUGE_VAL, bz0 = HUGE_VAL, bx1 = -HUGE_VAL, by1 = -HUGE_VAL, bz1 = -HUGE_VAL;
                 for (std::size_t t = b0; t < b1; ++t) {

@@ -11,6 +11,7 @@
 #endif
 
 #include "emulator_device.h"
+#include "exact_stage.h"
 #include "parallel.h"
 #include "spatialhash/broad_phase.h"
 
@@ -218,12 +219,7 @@ std::vector<Aabb> kept_vertex_bounds(std::span<const Mesh> objects, std::span<co
             hi_xy = _mm_max_pd(xy, hi_xy);
             hi_z = _mm_max_sd(z, hi_z);
         }
-        Aabb box;
-        _mm_storeu_pd(&box.lo.x, lo_xy);
-        _mm_store_sd(&box.lo.z, lo_z);
-        _mm_storeu_pd(&box.hi.x, hi_xy);
-        _mm_store_sd(&box.hi.z, hi_z);
-        job_box[j] = box;
+        job_box[j] = detail::aabb_sse2(lo_xy, lo_z, hi_xy, hi_z);
 #else
         // Six doubles in registers.
         double x0 = pos[jobs[j].first].x, y0 = pos[jobs[j].first].y, z0 = pos[jobs[j].first].z;

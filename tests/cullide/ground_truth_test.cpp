@@ -178,6 +178,20 @@ TEST_CASE("float_down and float_up give the nearest floats below and above, infi
     }
 }
 
+// A box bound for the float-box tests: one of `edges` (range edges, subnormals, signed zeros), raw
+// finite bits, or a value scaled 2^-160..2^160, a third of the time each.
+template <std::size_t N>
+double box_bound(test::Rng& rng, const double (&edges)[N]) {
+    switch (rng.below(3)) {
+        case 0: return edges[rng.below(N)];
+        case 1: {
+            const double x = std::bit_cast<double>(rng.next());
+            return std::isfinite(x) ? x : 1.5;
+        }
+        default: return std::ldexp(rng.sym(), static_cast<int>(rng.below(320)) - 160);
+    }
+}
+
 TEST_CASE("float_box(lo, hi) rounds every bound as float_down and float_up do, to the bit") {
     // The scan's box rounding (four bounds per SSE2 step on x86-64) against the scalar functions,
     // lane by lane: each bound of a box lands in a different lane, so a lane mix-up fails here.
@@ -187,16 +201,7 @@ TEST_CASE("float_box(lo, hi) rounds every bound as float_down and float_up do, t
     const auto flt_max = static_cast<double>(std::numeric_limits<float>::max());
     const double edges[] = {0.0, -0.0, 1e-300, -1e-300, 0x1p-149, -0x1.8p-149, flt_max, -flt_max,
                             std::nextafter(flt_max, 1e300), -std::nextafter(flt_max, 1e300), 1e300, -1e300, 0.1, -0.1};
-    const auto draw = [&]() -> double {
-        switch (rng.below(3)) {
-            case 0: return edges[rng.below(std::size(edges))];
-            case 1: {
-                const double x = std::bit_cast<double>(rng.next());
-                return std::isfinite(x) ? x : 1.5;
-            }
-            default: return std::ldexp(rng.sym(), static_cast<int>(rng.below(320)) - 160);
-        }
-    };
+    const auto draw = [&] { return box_bound(rng, edges); };
     std::uint64_t differ = 0;
     for (int i = 0; i < 300000; ++i) {
         const Vec3 lo{draw(), draw(), draw()}, hi{draw(), draw(), draw()};
@@ -222,16 +227,7 @@ TEST_CASE("float_box_round_down under a RoundDownScope gives float_box's bits, a
     const double edges[] = {0.0, -0.0, 1e-300, -1e-300, 0x1p-149, -0x1.8p-149, 0x1p-150, -0x1p-150, 1e-320, -1e-320,
                             flt_max, -flt_max, std::nextafter(flt_max, 1e300), -std::nextafter(flt_max, 1e300), 1e300,
                             -1e300, 0.1, -0.1, 1.0, -1.0};
-    const auto draw = [&]() -> double {
-        switch (rng.below(3)) {
-            case 0: return edges[rng.below(std::size(edges))];
-            case 1: {
-                const double x = std::bit_cast<double>(rng.next());
-                return std::isfinite(x) ? x : 1.5;
-            }
-            default: return std::ldexp(rng.sym(), static_cast<int>(rng.below(320)) - 160);
-        }
-    };
+    const auto draw = [&] { return box_bound(rng, edges); };
     // The boxes and float_down's bits first, in the caller's mode.
     std::vector<std::array<double, 6>> boxes(100000);
     std::vector<std::array<float, 6>> want(boxes.size());
