@@ -122,6 +122,19 @@ template <RasterRules Rules>
 void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const ClipVertex* v1, const ClipVertex* v2,
                            std::uint32_t draw, std::vector<SetupTri>& out) {
     constexpr RuleSet rules = rule_set(Rules);
+    // Window positions outside the fixed-point range are dropped. Clipping (no guard band) keeps a
+    // finite vertex inside the viewport, so only two things put one outside: a clipped vertex with
+    // w = 0 (1/w overflows, NaN or infinite position) and the rounding of the clip interpolation
+    // on coordinates near 2^100 (errors of 2^75 px and more). llvmpipe converts such a position to
+    // 0x80000000 (cvtps2dq's integer indefinite) and rasterizes the edges that make; our 64-bit
+    // edge functions would overflow (undefined, and the kernels then disagreed: the raster_gl_exact
+    // fuzz finding of session 7). |snapped| < 2^30 keeps every product of setup and the kernels
+    // within 62 bits; it is 4,194,304 px, far beyond any target (kMaxTargetSize) or viewport.
+    // docs/raster-known-differences.md, "Window positions out of range".
+    const auto in_range = [](float w) { return std::fabs((w - 0.5f) * kFixedOne) < 0x1p30f; };  // NaN: false
+    if (!(in_range(v0->win[0]) && in_range(v0->win[1]) && in_range(v1->win[0]) && in_range(v1->win[1]) &&
+          in_range(v2->win[0]) && in_range(v2->win[1])))
+        return;
     // Snap to 16.8 after moving the pixel centre to the integer lattice (round half to even, as
     // cvtps2dq does in the default rounding mode).
     auto snap = [](float w) { return static_cast<int64_t>(std::lrint((w - 0.5f) * kFixedOne)); };
