@@ -1,7 +1,10 @@
 // command_batch.cpp: recording and up-front validation of a command batch.
 #include "raster/command_batch.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <span>
 #include <string>
 
 #include "validate.h"
@@ -63,6 +66,55 @@ std::string check_exact_bounds_vertex(double x, double y, double z, double w) {
     return {};
 }
 std::string cmd_name(std::size_t i) { return "command " + std::to_string(i); }
+
+// Whether every vertex of a whole list passes its draw's per-vertex rule (below), without naming
+// one: a straight pass over the list with no message, which the per-index loop's gathers and error
+// branches cost several times over (validation was 5% of a cylinders / cullide frame's
+// instructions: callgrind, issue #17).
+bool gl_list_valid(std::span<const Float4> verts) {
+    bool ok = true;
+    for (const Float4& v : verts)
+        ok = ok && finite4(v) && !(v.w == 0.0f && v.x == 0.0f && v.y == 0.0f && v.z == 0.0f);
+    return ok;
+}
+template <class V>
+bool exact_bounds_list_valid(std::span<const V> verts) {
+    bool ok = true;
+    for (const V& v : verts) {
+        const double x = static_cast<double>(v.x), y = static_cast<double>(v.y), z = static_cast<double>(v.z);
+        // The comparisons are false for NaN, and an infinity exceeds the bound: check_exact_bounds_vertex's rules.
+        ok = ok && static_cast<double>(v.w) == 1.0 && std::fabs(x) <= kMaxExactBoundsCoordinate &&
+             std::fabs(y) <= kMaxExactBoundsCoordinate && std::fabs(z) <= kMaxExactBoundsCoordinate;
+    }
+    return ok;
+}
+
+// The vertex lists of a batch already found wholly valid. Draws that index one list in many pieces
+// (CULLIDE's sub-objects: 12 of an object's indices per draw) check it once. A whole list costs its
+// length, so it is checked only within an allowance of four vertices per index validated so far in
+// the batch: a batch of small draws into large, alternating lists costs at most a few times the
+// per-index loop, never its list sizes over and over.
+class ListMemo {
+   public:
+    // Whether `verts` (first vertex `data`, `size` of them) is known or now found valid; `check`
+    // tests the whole list. `indices` is the draw's index count.
+    template <class Check>
+    bool valid(const void* data, std::size_t size, std::size_t indices, const Check& check) {
+        allowance_ += 4 * indices;
+        if (data == data_ && size <= size_) return true;
+        if (size > allowance_) return false;
+        allowance_ -= size;
+        if (!check()) return false;
+        data_ = data;
+        size_ = size;
+        return true;
+    }
+
+   private:
+    const void* data_ = nullptr;
+    std::size_t size_ = 0;
+    std::size_t allowance_ = 0;
+};
 }  // namespace
 
 Status validate(const DepthTarget& target, const CommandBatch& batch) {
@@ -72,6 +124,7 @@ Status validate(const DepthTarget& target, const CommandBatch& batch) {
                      std::to_string(target.width()) + "x" + std::to_string(target.height())};
     }
     bool active = false;
+    ListMemo gl_lists, bounds_lists, bounds_lists_d;
     const auto& cmds = batch.commands();
     for (std::size_t i = 0; i < cmds.size(); ++i) {
         const Command& c = cmds[i];
@@ -113,7 +166,32 @@ Status validate(const DepthTarget& target, const CommandBatch& batch) {
                 if (idx.size() % 3 != 0) {
                     return Error{cmd_name(i) + ": index count " + std::to_string(idx.size()) + " is not a multiple of 3"};
                 }
-                // Only vertices that triangles use are checked (a shared vertex list may hold others).
+                // Fast path: every index in range and the whole vertex list valid (known from an
+                // earlier draw of the batch, or checked now). Otherwise the loop below finds the
+                // first offence and names it; it checks only the vertices that triangles use (a
+                // shared vertex list may hold others), so a list with an invalid unused vertex is
+                // still accepted, only more slowly.
+                {
+                    std::uint32_t max_index = 0;
+                    for (const std::uint32_t k : idx) max_index = std::max(max_index, k);
+                    bool list_ok = false;
+                    if (idx.empty() || max_index < vertex_count) {
+                        if (c.double_input) {
+                            const auto verts = c.mesh_d.vertices;
+                            list_ok = bounds_lists_d.valid(verts.data(), verts.size(), idx.size(),
+                                                           [&] { return exact_bounds_list_valid(verts); });
+                        } else if (s.mode == RasterMode::ExactBounds) {
+                            const auto verts = c.mesh.vertices;
+                            list_ok = bounds_lists.valid(verts.data(), verts.size(), idx.size(),
+                                                         [&] { return exact_bounds_list_valid(verts); });
+                        } else {
+                            const auto verts = c.mesh.vertices;
+                            list_ok = gl_lists.valid(verts.data(), verts.size(), idx.size(),
+                                                     [&] { return gl_list_valid(verts); });
+                        }
+                    }
+                    if (list_ok) break;
+                }
                 for (std::size_t k = 0; k < idx.size(); ++k) {
                     if (idx[k] >= vertex_count) {
                         return Error{cmd_name(i) + ": index " + std::to_string(idx[k]) + " at position " +

@@ -4,8 +4,11 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "raster/raster.h"
@@ -130,6 +133,71 @@ TEST_CASE("Bad batches are rejected before anything is drawn and name the elemen
         b3.draw({good, tri}, {});
         expect_error(b3, "still active");
     }
+}
+
+TEST_CASE("Shared vertex lists: validation names a used bad vertex whatever earlier draws checked, and ignores unused ones") {
+    // command_batch.cpp checks a whole vertex list once per batch when it can (ListMemo) and falls
+    // back to the per-index loop; the answers must be the per-index rules' in every order.
+    const int W = 16, H = 16;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    std::vector<Float4> v = {px(1, 1, 0.5f, W, H), px(15, 1, 0.5f, W, H), px(1, 15, 0.5f, W, H), {nan, 0.0f, 0.0f, 1.0f}};
+    const std::vector<std::uint32_t> tri = {0, 1, 2}, uses_bad = {0, 1, 3};
+    const std::span<const Float4> all(v), first3 = std::span<const Float4>(v).first(3);
+    auto run = [&](const raster::CommandBatch& b, const raster::ExecuteOptions& o, bool reference) {
+        auto t = raster::DepthTarget::create(W, H, DepthFormat::D24).value();
+        REQUIRE(t.clear(1.0).ok());
+        auto r = reference ? raster::execute_reference(t, b, o) : raster::execute(t, b, o);
+        return std::make_pair(r.ok() ? std::string{} : r.error().message, snapshot(t));
+    };
+    for (const auto mode : {raster::RasterMode::GLExact, raster::RasterMode::ExactBounds}) {
+        CAPTURE(static_cast<int>(mode));
+        raster::DrawState s;
+        s.mode = mode;
+        s.depth_func = raster::DepthFunc::Always;
+        // Unused bad vertex: accepted, and the same depths as the list without it.
+        raster::CommandBatch with_bad(W, H), without(W, H);
+        for (int k = 0; k < 5; ++k) {
+            with_bad.draw({all, tri}, s);
+            without.draw({first3, tri}, s);
+        }
+        for (const bool reference : {false, true}) {
+            const auto a = run(with_bad, {}, reference), b = run(without, {}, reference);
+            CHECK(a.first.empty());
+            CHECK(b.first.empty());
+            CHECK(a.second == b.second);
+        }
+        // The bad vertex used after many draws of the list (whole-list check failed) and after
+        // draws of its first three vertices (the list known valid, but shorter): named either way.
+        for (const bool prefix : {false, true}) {
+            raster::CommandBatch b(W, H);
+            for (int k = 0; k < 20; ++k) b.draw({prefix ? first3 : all, tri}, s);
+            b.draw({all, uses_bad}, s);
+            for (const bool reference : {false, true}) {
+                const auto r = run(b, {}, reference);
+                CAPTURE(r.first);
+                CHECK(r.first.find("command 20: vertex 3 ") != std::string::npos);
+            }
+        }
+        // An index beyond the list after the list was found valid.
+        raster::CommandBatch b(W, H);
+        for (int k = 0; k < 20; ++k) b.draw({first3, tri}, s);
+        const std::vector<std::uint32_t> beyond = {0, 1, 3};
+        b.draw({first3, beyond}, s);
+        CHECK(run(b, {}, false).first.find("command 20: index 3 at position 2 is beyond the vertex list (size 3)") !=
+              std::string::npos);
+    }
+    // Double input (exact bounds): w != 1 on a used vertex is named after the list was checked.
+    std::vector<raster::Double4> d = {{-0.5, -0.5, 0.5, 1.0}, {0.5, -0.5, 0.5, 1.0}, {0.0, 0.5, 0.5, 1.0}, {0.0, 0.0, 0.0, 2.0}};
+    raster::DrawState s;
+    s.mode = raster::RasterMode::ExactBounds;
+    raster::CommandBatch ok_batch(W, H), bad_batch(W, H);
+    for (int k = 0; k < 8; ++k) {
+        ok_batch.draw(raster::MeshViewD{d, tri}, s);
+        bad_batch.draw(raster::MeshViewD{d, tri}, s);
+    }
+    bad_batch.draw(raster::MeshViewD{d, uses_bad}, s);
+    CHECK(run(ok_batch, {}, false).first.empty());
+    CHECK(run(bad_batch, {}, false).first.find("command 8: vertex 3 has w = 2") != std::string::npos);
 }
 
 TEST_CASE("Two triangles sharing a diagonal cover a pixel-aligned square exactly once") {
