@@ -2,7 +2,9 @@
 #include "emulator_device.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
+#include <cstring>
 
 #include "parallel.h"
 #include "raster/command_batch.h"
@@ -33,6 +35,11 @@ Status EmulatorDevice::clear(int width, int height, raster::DepthFormat format) 
     std::uint32_t* const values = target_->mutable_values().data();
     constexpr int side = raster::kExecuteTileSize;
     const std::size_t tiles_y = written_tiles_.size() / static_cast<std::size_t>(tiles_x_);
+    // Each tile row is copied from a row of clear values (memcpy: wide stores on any target, where
+    // the element loop of std::fill stored one value per instruction; 8.8% of a cylinders / cullide
+    // frame's instructions, callgrind).
+    std::array<std::uint32_t, side> ones;
+    ones.fill(one);
     const auto clear_row = [&](std::size_t ty) {
         for (int tx = 0; tx < tiles_x_; ++tx) {
             std::uint8_t& flag = written_tiles_[ty * static_cast<std::size_t>(tiles_x_) + static_cast<std::size_t>(tx)];
@@ -42,7 +49,7 @@ Status EmulatorDevice::clear(int width, int height, raster::DepthFormat format) 
             const int y0 = static_cast<int>(ty) * side, y1 = std::min(height, y0 + side);
             for (int y = y0; y < y1; ++y) {
                 std::uint32_t* row = values + static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
-                std::fill(row + x0, row + x1, one);
+                std::memcpy(row + x0, ones.data(), static_cast<std::size_t>(x1 - x0) * sizeof(std::uint32_t));
             }
         }
     };
