@@ -156,6 +156,11 @@ void draws(const CommandBatch& batch, Draws& d) {
 // `bounds` and its vertex `pool`).
 struct SetupDraws {
     std::vector<std::uint32_t> src;  // per draw: the draw whose `tris` it uses (itself, or an equal earlier one)
+    // Per draw: the face culling the list still needs at binning (CullFace::None when the list
+    // was set up with the draw's own culling), and per source draw, the culling its list is set
+    // up with (share_setup).
+    std::vector<CullFace> bin_cull;
+    std::vector<CullFace> setup_cull;
     std::vector<std::vector<detail::SetupTri>> tris;
     std::vector<std::vector<detail::BoundsTri>> bounds;
     std::vector<std::vector<detail::BoundsVertex>> pool;
@@ -173,14 +178,14 @@ void reset_lists(std::vector<std::vector<T>>& lists, std::size_t n) {
 }
 
 // What a GL-exact draw's front end reads: its vertex and index spans (by address: the same
-// triangles) and the state it depends on (the target and rules are the batch's).
+// triangles) and the state it depends on (the target and rules are the batch's), except face
+// culling, which only drops some of the list's triangles (SetupTri::front).
 struct SetupKey {
     const Float4* vertices;
     std::size_t n_vertices;
     const std::uint32_t* indices;
     std::size_t n_indices;
     int vx, vy, vw, vh;
-    CullFace cull;
     FrontFace front;
     bool operator==(const SetupKey&) const = default;
 };
@@ -193,23 +198,38 @@ struct SetupKeyHash {
 };
 using SetupIndex = std::unordered_map<SetupKey, std::uint32_t, SetupKeyHash>;
 
-// Marks draws that repeat an earlier GL-exact draw of the batch (same spans, same front-end state)
-// as users of that draw's setup list: CULLIDE draws each item twice in a batch (its query, then its
-// write), and the setup list is a pure function of the key, so sharing it changes no bit.
+// Marks draws that repeat an earlier GL-exact draw of the batch (same spans, same front-end state
+// but for culling) as users of that draw's setup list: CULLIDE draws each item twice in a batch (its
+// query, then its write), and the setup list is a pure function of the key and the culling, so
+// sharing it changes no bit. When the users of one list cull differently (R-CULLIDE's offset
+// solids: the query culls front faces, the write back faces), the list is set up without culling
+// and each draw drops the faces it culls at binning: setup's list with culling is exactly the
+// unculled list without those triangles, in the same order (setup culls each triangle, and each
+// triangle of a clipped fan, by its own facing, after everything else that decides whether it
+// exists). So the triangles are clipped, snapped and set up once instead of once per culling.
 void share_setup(const DepthTarget& target, const CommandBatch& batch, const Draws& draws, SetupDraws& out,
                  SetupIndex& index) {
     const auto& cmds = batch.commands();
     const std::size_t n_draws = draws.cmds.size();
     out.src.resize(n_draws);
+    out.bin_cull.assign(n_draws, CullFace::None);
+    out.setup_cull.assign(n_draws, CullFace::None);
     index.clear();
     for (std::size_t d = 0; d < n_draws; ++d) {
         out.src[d] = static_cast<std::uint32_t>(d);
         const Command& c = cmds[draws.cmds[d]];
+        out.setup_cull[d] = c.state.cull_face;
         if (c.state.mode == RasterMode::ExactBounds || c.double_input) continue;
         const detail::FrontEndParams p = params_for(target, batch.rules(), c.state);
         const SetupKey key{c.mesh.vertices.data(), c.mesh.vertices.size(), c.mesh.indices.data(), c.mesh.indices.size(),
-                           p.viewport.x, p.viewport.y, p.viewport.width, p.viewport.height, p.cull_face, p.front_face};
-        out.src[d] = index.try_emplace(key, static_cast<std::uint32_t>(d)).first->second;
+                           p.viewport.x, p.viewport.y, p.viewport.width, p.viewport.height, p.front_face};
+        const std::uint32_t src = index.try_emplace(key, static_cast<std::uint32_t>(d)).first->second;
+        out.src[d] = src;
+        if (out.setup_cull[src] != c.state.cull_face) out.setup_cull[src] = CullFace::None;
+    }
+    for (std::size_t d = 0; d < n_draws; ++d) {
+        const CullFace own = cmds[draws.cmds[d]].state.cull_face;
+        if (out.setup_cull[out.src[d]] != own) out.bin_cull[d] = own;
     }
 }
 
@@ -241,7 +261,8 @@ void front_end(const DepthTarget& target, const CommandBatch& batch, const Draws
     detail::parallel_for(threads, pieces.size(), [&](std::size_t j) {
         const std::size_t d = pieces[j].draw;
         const Command& c = cmds[draws.cmds[d]];
-        const detail::FrontEndParams p = params_for(target, batch.rules(), c.state);
+        detail::FrontEndParams p = params_for(target, batch.rules(), c.state);
+        p.cull_face = out.setup_cull[d];  // None when draws of other culling share this list
         if (c.state.mode == RasterMode::ExactBounds) {
             setup_bounds_draw(p, c, draws.cmds[d], out.bounds[d], out.pool[d]);
             return;
@@ -290,10 +311,16 @@ void bin(const SetupDraws& setup, std::size_t n_draws, const Tiles& tiles, int t
             for (int ty = std::max(by0 / kTileSize, band_ty0); ty <= std::min(by1 / kTileSize, band_ty1); ++ty)
                 for (int tx = bx0 / kTileSize; tx <= bx1 / kTileSize; ++tx) add(d, t, tx, ty);
         };
-        for (std::size_t d = 0; d < n_draws; ++d) {
-            const auto& tris = setup.tris[setup.src[d]];
+        // Draw d's GL-exact triangles into this band's tiles; with Cull, without those of the
+        // facing the draw culls (share_setup left its culling to binning: CullFace::Front drops
+        // front-facing triangles, CullFace::Back back-facing ones). A template, so that draws
+        // without it keep a loop with no test (the test cost 0.6% of a cullide frame's instructions).
+        const auto bin_list = [&]<bool Cull>(std::size_t d, const std::vector<detail::SetupTri>& tris, bool drop_front) {
             for (std::size_t t = 0; t < tris.size(); ++t) {
                 const auto& tri = tris[t];
+                if constexpr (Cull) {
+                    if (tri.front == drop_front) continue;
+                }
                 const int ty0 = std::max(tri.y0 / kTileSize, band_ty0), ty1 = std::min(tri.y1 / kTileSize, band_ty1);
                 if (ty0 > ty1) continue;
                 if (tri.y0 / kTileSize == tri.y1 / kTileSize && tri.x0 / kTileSize == tri.x1 / kTileSize) {
@@ -313,6 +340,14 @@ void bin(const SetupDraws& setup, std::size_t n_draws, const Tiles& tiles, int t
                     }
                 }
             }
+        };
+        for (std::size_t d = 0; d < n_draws; ++d) {
+            const auto& tris = setup.tris[setup.src[d]];
+            const CullFace cull = setup.bin_cull[d];
+            if (cull == CullFace::None)
+                bin_list.template operator()<false>(d, tris, false);
+            else
+                bin_list.template operator()<true>(d, tris, cull == CullFace::Front);
             for (std::size_t t = 0; t < setup.bounds[d].size(); ++t) {
                 const auto& tri = setup.bounds[d][t];
                 bin_box(d, t, tri.x0, tri.y0, tri.x1, tri.y1);

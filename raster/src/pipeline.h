@@ -40,6 +40,10 @@ struct SetupTri {
     // columns to the right, [x0, x1 + 7] x [y0, y1], fits in 32 bits, so the AVX2 kernel's narrow
     // path may run on any rectangle inside the box without its own bound (triangle_setup.cpp).
     bool fits32;
+    // Whether the triangle is front-facing under its draw's FrontFace (the face culling test of
+    // setup). The tiled executor sets up a triangle once for draws that differ only in culling and
+    // culls at binning by this flag (execute.cpp, share_setup).
+    bool front;
 };
 
 struct FrontEndParams {

@@ -217,6 +217,7 @@ void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const 
     t.dzdx = dadx;
     t.dzdy = dady;
     t.draw = draw;
+    t.front = front;
     // SetupTri::fits32 from the snapped extents (two products; an exact bound over the box's
     // corners cost about 40 instructions per triangle, more than the kernel saved: callgrind,
     // cylinders frame). Edge i at the pixel centre (px, py) is

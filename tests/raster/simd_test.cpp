@@ -12,6 +12,7 @@
 #include <bit>
 #include <cstdint>
 #include <cstdlib>
+#include <span>
 #include <vector>
 
 #include "pipeline.h"
@@ -628,4 +629,68 @@ TEST_CASE("window positions out of the fixed-point range: setup drops the triang
             CHECK(std::equal(va.begin(), va.end(), vb.begin(), vb.end()));
         }
     }
+}
+
+// The tiled executor sets up a triangle list once for draws of the same spans that differ only in
+// face culling (R-CULLIDE's offset solids: the query culls front faces, the write back faces) and
+// culls at binning (execute.cpp, share_setup). Random solids-like meshes (some crossing the near
+// plane, so clipped fans cull triangle by triangle), each drawn with every culling, both front-face
+// conventions and sub-spans, interleaved with queries: every bit equals the reference, which sets up
+// each draw with its own culling.
+TEST_CASE("draws that share geometry but not culling: tiled executor == reference, every bit") {
+    raster_test::SplitMix64 rng(0xc011u);
+    const int w = 150, h = 130;
+    std::uint64_t culled_differently = 0;
+    for (int rep = 0; rep < 12; ++rep) {
+        std::vector<raster::Float4> v;
+        std::vector<std::uint32_t> idx;
+        const int n_tris = 1 + static_cast<int>(rng.below(60));
+        for (int t = 0; t < n_tris; ++t) {
+            const float cx = rng.uniform(-1.2f, 1.2f), cy = rng.uniform(-1.2f, 1.2f), r = rng.uniform(0.01f, 0.6f);
+            for (int k = 0; k < 3; ++k) {
+                idx.push_back(static_cast<std::uint32_t>(v.size()));
+                const float z = rng.chance(10) ? rng.uniform(-1.6f, 1.6f) : rng.uniform(-0.9f, 0.9f);
+                v.push_back({cx + rng.uniform(-r, r), cy + rng.uniform(-r, r), z, 1.0f});
+            }
+        }
+        const std::span<const std::uint32_t> all(idx);
+        const std::span<const std::uint32_t> half = all.first(idx.size() / 6 * 3);
+        raster::CommandBatch batch(w, h);
+        for (int k = 0; k < 10; ++k) {
+            raster::DrawState s;
+            const auto span = rng.chance(30) ? half : all;
+            s.cull_face = static_cast<raster::CullFace>(rng.below(3));
+            s.front_face = rng.chance(20) ? raster::FrontFace::CW : raster::FrontFace::CCW;
+            s.depth_write = rng.chance(50);
+            s.depth_func = s.depth_write ? DepthFunc::LEqual : DepthFunc::GEqual;
+            if (s.cull_face != raster::CullFace::None) ++culled_differently;
+            const bool query = !s.depth_write || rng.chance(30);
+            if (query)
+                batch.begin_query(rng.chance(50) ? raster::QueryKind::AnySamplesPassed : raster::QueryKind::SamplesPassed);
+            batch.draw(raster::MeshView{v, span}, s);
+            if (query) batch.end_query();
+        }
+        for (const auto f : kFormats) {
+            auto ref = raster::DepthTarget::create(w, h, f).value();
+            REQUIRE(ref.clear(0.75).ok());
+            const auto want = raster::execute_reference(ref, batch, raster::ExecuteOptions{1, false});
+            REQUIRE(want.ok());
+            for (const int threads : {1, 2, 3}) {
+                for (const bool simd : {false, true}) {
+                    CAPTURE(rep);
+                    CAPTURE(static_cast<int>(f));
+                    CAPTURE(threads);
+                    CAPTURE(simd);
+                    auto t = raster::DepthTarget::create(w, h, f).value();
+                    REQUIRE(t.clear(0.75).ok());
+                    const auto got = raster::execute(t, batch, raster::ExecuteOptions{threads, simd});
+                    REQUIRE(got.ok());
+                    CHECK(got.value() == want.value());
+                    const auto va = ref.values(), vb = t.values();
+                    CHECK(std::equal(va.begin(), va.end(), vb.begin(), vb.end()));
+                }
+            }
+        }
+    }
+    CHECK(culled_differently > 50);
 }
