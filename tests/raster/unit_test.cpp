@@ -3,6 +3,7 @@
 // hand from the rules in raster/raster.h, not by running the code), and the transform helpers.
 #include <doctest/doctest.h>
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -11,7 +12,9 @@
 #include <utility>
 #include <vector>
 
+#include "float_step.h"
 #include "raster/raster.h"
+#include "scene_gen.h"
 
 namespace {
 
@@ -198,6 +201,37 @@ TEST_CASE("Shared vertex lists: validation names a used bad vertex whatever earl
     bad_batch.draw(raster::MeshViewD{d, uses_bad}, s);
     CHECK(run(ok_batch, {}, false).first.empty());
     CHECK(run(bad_batch, {}, false).first.find("command 8: vertex 3 has w = 2") != std::string::npos);
+}
+
+TEST_CASE("next_down / next_up (float_step.h) equal std::nextafter on every exponent, zeros, subnormals and the extremes") {
+    raster_test::SplitMix64 rng(0x57e9u);
+    std::vector<float> values = {0.0f, -0.0f, std::numeric_limits<float>::denorm_min(),
+                                 -std::numeric_limits<float>::denorm_min(), std::numeric_limits<float>::min(),
+                                 -std::numeric_limits<float>::min(), std::numeric_limits<float>::max(),
+                                 -std::numeric_limits<float>::max(), 1.0f, -1.0f};
+    for (std::uint32_t exponent = 0; exponent < 255; ++exponent) {  // every finite exponent, both signs
+        for (int k = 0; k < 2000; ++k) {
+            std::uint32_t mantissa = static_cast<std::uint32_t>(rng.next()) & 0x7fffffu;
+            if (k == 0) mantissa = 0;
+            if (k == 1) mantissa = 0x7fffffu;
+            const std::uint32_t bits = (exponent << 23) | mantissa | (k % 2 == 0 ? 0u : 0x80000000u);
+            values.push_back(std::bit_cast<float>(bits));
+        }
+    }
+    std::size_t differ = 0;
+    float first_bad = 0.0f;
+    for (const float f : values) {
+        const float down = raster::detail::next_down(f), up = raster::detail::next_up(f);
+        const float want_down = std::nextafter(f, -HUGE_VALF), want_up = std::nextafter(f, HUGE_VALF);
+        if (std::bit_cast<std::uint32_t>(down) != std::bit_cast<std::uint32_t>(want_down) ||
+            std::bit_cast<std::uint32_t>(up) != std::bit_cast<std::uint32_t>(want_up)) {
+            if (differ == 0) first_bad = f;
+            ++differ;
+        }
+    }
+    CHECK(values.size() > 500000);
+    CAPTURE(first_bad);
+    CHECK(differ == 0);
 }
 
 TEST_CASE("Two triangles sharing a diagonal cover a pixel-aligned square exactly once") {
