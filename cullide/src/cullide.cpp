@@ -265,19 +265,23 @@ Result<std::uint64_t> visibility_view(std::vector<ObjectGeometry>& g, const std:
 // visible items.
 Result<std::uint64_t> recorded_view(std::vector<ObjectGeometry>& g, std::vector<std::size_t> order,
                                     const CullideOptions& o, ViewSize size, QueryDevice& device, ViewStats& vs) {
-    std::array<raster::QueryResults, 2> results;
+    // Both passes are recorded first and run as one sequence, each on a cleared target: a device
+    // may share their work (the emulator sets each triangle up once for both).
+    std::array<raster::CommandBatch, 2> batches = {raster::CommandBatch(size.width(), size.height(), o.gpu_rules),
+                                                   raster::CommandBatch(size.width(), size.height(), o.gpu_rules)};
     for (int pass = 0; pass < 2; ++pass) {
         if (pass == 1) std::reverse(order.begin(), order.end());  // pass 2 runs backward
-        raster::CommandBatch batch(size.width(), size.height(), o.gpu_rules);
-        record_pass(batch, g, order, pass, o.mode, vs);
-        if (Status s = device.clear(size.width(), size.height(), o.depth_format); !s) return s.error();
-        Result<raster::QueryResults> r = device.execute(batch);
-        if (!r) return r.error();
-        if (r.value().size() != batch.query_kinds().size())
-            return Error{"device returned " + std::to_string(r.value().size()) + " query results for " +
-                         std::to_string(batch.query_kinds().size()) + " queries"};
-        results[static_cast<std::size_t>(pass)] = std::move(r).value();
+        record_pass(batches[static_cast<std::size_t>(pass)], g, order, pass, o.mode, vs);
     }
+    const raster::CommandBatch* const both[2] = {&batches[0], &batches[1]};
+    Result<std::vector<raster::QueryResults>> run = device.execute_cleared(size.width(), size.height(), o.depth_format, both);
+    if (!run) return run.error();
+    std::vector<raster::QueryResults>& results = run.value();
+    if (results.size() != 2) return Error{"device returned " + std::to_string(results.size()) + " passes for 2"};
+    for (std::size_t pass = 0; pass < 2; ++pass)
+        if (results[pass].size() != batches[pass].query_kinds().size())
+            return Error{"device returned " + std::to_string(results[pass].size()) + " query results for " +
+                         std::to_string(batches[pass].query_kinds().size()) + " queries"};
     std::uint64_t pruned = 0;
     for (std::size_t i : order) {
         for (Item& it : g[i].items) {

@@ -26,6 +26,9 @@ class EmulatorDevice final : public QueryDevice {
 
     Status clear(int width, int height, raster::DepthFormat format) override;
     Result<raster::QueryResults> execute(const raster::CommandBatch& batch) override;
+    Result<std::vector<raster::QueryResults>> execute_cleared(
+        int width, int height, raster::DepthFormat format,
+        std::span<const raster::CommandBatch* const> batches) override;
     Result<std::vector<std::uint8_t>> visibility_pass(ViewSize size, raster::DepthFormat format,
                                                       std::span<const raster::VisibilityItem> items) override;
     std::string name() const override { return "emulator"; }

@@ -12,6 +12,20 @@ Result<std::vector<std::uint8_t>> QueryDevice::visibility_pass(ViewSize size, ra
     return recorded_visibility_pass(size, format, items);
 }
 
+Result<std::vector<raster::QueryResults>> QueryDevice::execute_cleared(
+    int width, int height, raster::DepthFormat format, std::span<const raster::CommandBatch* const> batches) {
+    std::vector<raster::QueryResults> results;
+    results.reserve(batches.size());
+    for (const raster::CommandBatch* batch : batches) {
+        if (batch == nullptr) return Error{name() + ": execute_cleared: a batch is null"};
+        if (Status s = clear(width, height, format); !s) return s.error();
+        Result<raster::QueryResults> r = execute(*batch);
+        if (!r) return r.error();
+        results.push_back(std::move(r).value());
+    }
+    return results;
+}
+
 Result<std::vector<std::uint8_t>> QueryDevice::recorded_visibility_pass(
     ViewSize size, raster::DepthFormat format, std::span<const raster::VisibilityItem> items) {
     // Each object's items: [begin, end) runs of equal VisibilityItem::object.

@@ -3,8 +3,10 @@
 #include <atomic>
 #include <cstdint>
 #include <cstdlib>
+#include <functional>
 #include <limits>
 #include <memory>
+#include <span>
 #include <unordered_map>
 #include <string>
 #include <utility>
@@ -129,27 +131,40 @@ namespace {
 
 // The tiled executor's phases, in order: draws(), front_end(), bin(), then shade() per tile.
 
-// The draw commands of a batch and the query active at each command.
+// The draw commands of a sequence of batches (execute: one batch), in order: batch k's draws are
+// [first[k], first[k + 1]).
 struct Draws {
-    std::vector<std::uint32_t> cmds;       // command index of each draw, in command order
-    std::vector<std::uint32_t> cmd_query;  // per command: the active query, or kNoQuery
+    std::vector<const Command*> cmd;    // per draw: its command
+    std::vector<std::uint32_t> index;   // per draw: the command's index in its batch
+    std::vector<std::uint32_t> query;   // per draw: its batch's query active at it, or kNoQuery
+    std::vector<RasterRules> rules;     // per draw: its batch's rules
+    std::vector<std::size_t> first;     // per batch, and the total at the end
 };
 
-void draws(const CommandBatch& batch, Draws& d) {
-    const auto& cmds = batch.commands();
-    d.cmds.clear();
-    d.cmd_query.assign(cmds.size(), kNoQuery);
-    std::uint32_t active = kNoQuery;
-    for (std::size_t i = 0; i < cmds.size(); ++i) {
-        if (cmds[i].kind == Command::Kind::BeginQuery) {
-            active = cmds[i].query;
-        } else if (cmds[i].kind == Command::Kind::EndQuery) {
-            active = kNoQuery;
-        } else {
-            d.cmds.push_back(static_cast<std::uint32_t>(i));
-            d.cmd_query[i] = active;
+void draws(std::span<const CommandBatch* const> batches, Draws& d) {
+    d.cmd.clear();
+    d.index.clear();
+    d.query.clear();
+    d.rules.clear();
+    d.first.clear();
+    for (const CommandBatch* batch : batches) {
+        d.first.push_back(d.cmd.size());
+        const auto& cmds = batch->commands();
+        std::uint32_t active = kNoQuery;
+        for (std::size_t i = 0; i < cmds.size(); ++i) {
+            if (cmds[i].kind == Command::Kind::BeginQuery) {
+                active = cmds[i].query;
+            } else if (cmds[i].kind == Command::Kind::EndQuery) {
+                active = kNoQuery;
+            } else {
+                d.cmd.push_back(&cmds[i]);
+                d.index.push_back(static_cast<std::uint32_t>(i));
+                d.query.push_back(active);
+                d.rules.push_back(batch->rules());
+            }
         }
     }
+    d.first.push_back(d.cmd.size());
 }
 
 // The front end's output, one list per draw (a GL-exact draw fills `tris`, an exact-bounds draw
@@ -187,6 +202,7 @@ struct SetupKey {
     std::size_t n_indices;
     int vx, vy, vw, vh;
     FrontFace front;
+    RasterRules rules;
     bool operator==(const SetupKey&) const = default;
 };
 struct SetupKeyHash {
@@ -207,36 +223,33 @@ using SetupIndex = std::unordered_map<SetupKey, std::uint32_t, SetupKeyHash>;
 // unculled list without those triangles, in the same order (setup culls each triangle, and each
 // triangle of a clipped fan, by its own facing, after everything else that decides whether it
 // exists). So the triangles are clipped, snapped and set up once instead of once per culling.
-void share_setup(const DepthTarget& target, const CommandBatch& batch, const Draws& draws, SetupDraws& out,
-                 SetupIndex& index) {
-    const auto& cmds = batch.commands();
-    const std::size_t n_draws = draws.cmds.size();
+void share_setup(const DepthTarget& target, const Draws& draws, SetupDraws& out, SetupIndex& index) {
+    const std::size_t n_draws = draws.cmd.size();
     out.src.resize(n_draws);
     out.bin_cull.assign(n_draws, CullFace::None);
     out.setup_cull.assign(n_draws, CullFace::None);
     index.clear();
     for (std::size_t d = 0; d < n_draws; ++d) {
         out.src[d] = static_cast<std::uint32_t>(d);
-        const Command& c = cmds[draws.cmds[d]];
+        const Command& c = *draws.cmd[d];
         out.setup_cull[d] = c.state.cull_face;
         if (c.state.mode == RasterMode::ExactBounds || c.double_input) continue;
-        const detail::FrontEndParams p = params_for(target, batch.rules(), c.state);
+        const detail::FrontEndParams p = params_for(target, draws.rules[d], c.state);
         const SetupKey key{c.mesh.vertices.data(), c.mesh.vertices.size(), c.mesh.indices.data(), c.mesh.indices.size(),
-                           p.viewport.x, p.viewport.y, p.viewport.width, p.viewport.height, p.front_face};
+                           p.viewport.x, p.viewport.y, p.viewport.width, p.viewport.height, p.front_face, p.rules};
         const std::uint32_t src = index.try_emplace(key, static_cast<std::uint32_t>(d)).first->second;
         out.src[d] = src;
         if (out.setup_cull[src] != c.state.cull_face) out.setup_cull[src] = CullFace::None;
     }
     for (std::size_t d = 0; d < n_draws; ++d) {
-        const CullFace own = cmds[draws.cmds[d]].state.cull_face;
+        const CullFace own = draws.cmd[d]->state.cull_face;
         if (out.setup_cull[out.src[d]] != own) out.bin_cull[d] = own;
     }
 }
 
-void front_end(const DepthTarget& target, const CommandBatch& batch, const Draws& draws, int threads,
-               SetupDraws& out, std::vector<std::vector<detail::SetupTri>>& piece_out) {
-    const auto& cmds = batch.commands();
-    const std::size_t n_draws = draws.cmds.size();
+void front_end(const DepthTarget& target, const Draws& draws, int threads, SetupDraws& out,
+               std::vector<std::vector<detail::SetupTri>>& piece_out) {
+    const std::size_t n_draws = draws.cmd.size();
     reset_lists(out.tris, n_draws);
     reset_lists(out.bounds, n_draws);
     reset_lists(out.pool, n_draws);
@@ -248,7 +261,7 @@ void front_end(const DepthTarget& target, const CommandBatch& batch, const Draws
     std::vector<Piece> pieces;
     for (std::size_t d = 0; d < n_draws; ++d) {
         if (out.src[d] != d) continue;  // shares an earlier draw's list
-        const Command& c = cmds[draws.cmds[d]];
+        const Command& c = *draws.cmd[d];
         const std::size_t n = c.state.mode == RasterMode::ExactBounds ? 0 : c.mesh.indices.size() / 3 * 3;
         if (threads == 1 || n <= 3 * kFrontEndPiece) {
             pieces.push_back({static_cast<std::uint32_t>(d), 0, n});
@@ -260,11 +273,11 @@ void front_end(const DepthTarget& target, const CommandBatch& batch, const Draws
     reset_lists(piece_out, pieces.size());
     detail::parallel_for(threads, pieces.size(), [&](std::size_t j) {
         const std::size_t d = pieces[j].draw;
-        const Command& c = cmds[draws.cmds[d]];
-        detail::FrontEndParams p = params_for(target, batch.rules(), c.state);
+        const Command& c = *draws.cmd[d];
+        detail::FrontEndParams p = params_for(target, draws.rules[d], c.state);
         p.cull_face = out.setup_cull[d];  // None when draws of other culling share this list
         if (c.state.mode == RasterMode::ExactBounds) {
-            setup_bounds_draw(p, c, draws.cmds[d], out.bounds[d], out.pool[d]);
+            setup_bounds_draw(p, c, draws.index[d], out.bounds[d], out.pool[d]);
             return;
         }
         const auto& idx = c.mesh.indices;
@@ -272,7 +285,7 @@ void front_end(const DepthTarget& target, const CommandBatch& batch, const Draws
         auto& list = pieces[j].k0 == 0 ? out.tris[d] : piece_out[j];
         list.reserve(list.size() + (pieces[j].k1 - pieces[j].k0) / 3);  // one SetupTri per unclipped triangle
         for (std::size_t k = pieces[j].k0; k + 2 < pieces[j].k1; k += 3)
-            detail::setup_triangle(p, vtx[idx[k]], vtx[idx[k + 1]], vtx[idx[k + 2]], draws.cmds[d], list);
+            detail::setup_triangle(p, vtx[idx[k]], vtx[idx[k + 1]], vtx[idx[k + 2]], draws.index[d], list);
     });
     for (std::size_t j = 0; j < pieces.size(); ++j)
         if (pieces[j].k0 != 0)
@@ -296,7 +309,7 @@ struct Ref {
 // Binning: each tile lists the triangles overlapping it, in command order. In parallel over bands
 // of tile rows: each band walks every triangle in command order and fills only its own tiles, so
 // every bin is the same list for any thread count.
-void bin(const SetupDraws& setup, std::size_t n_draws, const Tiles& tiles, int threads,
+void bin(const SetupDraws& setup, std::size_t d0, std::size_t d1, const Tiles& tiles, int threads,
          std::vector<std::vector<Ref>>& bins) {
     reset_lists(bins, tiles.count());
     const int bands = threads > 1 ? std::min(threads, tiles.y) : 1;
@@ -341,7 +354,7 @@ void bin(const SetupDraws& setup, std::size_t n_draws, const Tiles& tiles, int t
                 }
             }
         };
-        for (std::size_t d = 0; d < n_draws; ++d) {
+        for (std::size_t d = d0; d < d1; ++d) {
             const auto& tris = setup.tris[setup.src[d]];
             const CullFace cull = setup.bin_cull[d];
             if (cull == CullFace::None)
@@ -368,17 +381,17 @@ struct DrawInfo {
     bool any_only;                 // an any-samples query with the mask off (see shade)
 };
 
-void draw_infos(const CommandBatch& batch, const Draws& draws, const SetupDraws& setup, DepthFormat format,
-                bool allow_simd, bool hiz,
+// For the draws [d0, d1) of `batch` (a sequence's batch k: d0 = first[k], d1 = first[k + 1]);
+// `out` is indexed by the sequence's draw index.
+void draw_infos(const CommandBatch& batch, const Draws& draws, std::size_t d0, std::size_t d1,
+                const SetupDraws& setup, DepthFormat format, bool allow_simd, bool hiz,
                 std::vector<DrawInfo>& out) {
-    const auto& cmds = batch.commands();
     const auto& query_kinds = batch.query_kinds();
-    out.resize(draws.cmds.size());
-    for (std::size_t d = 0; d < draws.cmds.size(); ++d) {
-        const std::uint32_t cmd = draws.cmds[d];
-        const Command& c = cmds[cmd];
+    if (out.size() < d1) out.resize(d1);
+    for (std::size_t d = d0; d < d1; ++d) {
+        const Command& c = *draws.cmd[d];
         DrawInfo& info = out[d];
-        info.query = draws.cmd_query[cmd];
+        info.query = draws.query[d];
         info.exact_bounds = c.state.mode == RasterMode::ExactBounds;
         info.write = c.state.depth_write;
         info.any_only = info.query != kNoQuery && !c.state.depth_write &&
@@ -394,7 +407,6 @@ void draw_infos(const CommandBatch& batch, const Draws& draws, const SetupDraws&
 // What every tile's back end reads (shared, read-only but for the depth values of its own tile
 // and the any-samples flags).
 struct ShadeContext {
-    const CommandBatch& batch;
     const Draws& draws;
     const SetupDraws& setup;
     const DrawInfo* info;  // per draw (draw_infos)
@@ -416,7 +428,6 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
     const auto clip_to_tile = [&](int bx0, int by0, int bx1, int by1) {
         return detail::PixelRect{std::max(x0, bx0), std::max(y0, by0), std::min(x1, bx1), std::min(y1, by1)};
     };
-    const auto& cmds = ctx.batch.commands();
     detail::HizTile* const hiz =
         ctx.hiz ? &ctx.hiz_tiles[static_cast<std::size_t>(ty) * static_cast<std::size_t>((ctx.width + kTileSize - 1) / kTileSize) +
                                  static_cast<std::size_t>(tx)]
@@ -431,7 +442,7 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
         const std::uint32_t q = info.query;
         std::uint64_t passed;
         if (info.exact_bounds) {
-            const Command& c = cmds[ctx.draws.cmds[r.draw]];
+            const Command& c = *ctx.draws.cmd[r.draw];
             const detail::DepthState depth_state{ctx.format, c.state.depth_func, c.state.depth_write};
             if (c.state.depth_write) wrote = true;
             const auto& tri = ctx.setup.bounds[r.draw][r.tri];
@@ -469,14 +480,22 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
 
 }  // namespace
 
-Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, const ExecuteOptions& options) {
+Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::span<const CommandBatch* const> batches,
+                                                   const ExecuteOptions& options,
+                                                   const std::function<void(std::size_t)>& between) {
     if (options.threads < 0)
         return Error{"execute: threads = " + std::to_string(options.threads) +
                      " is out of range: it must be >= 0 (0 = all hardware threads)"};
-    if (Status s = detail::validate(target, batch); !s) return s.error();
+    for (std::size_t k = 0; k < batches.size(); ++k) {
+        if (batches[k] == nullptr) return Error{"execute_sequence: batch " + std::to_string(k) + " is null"};
+        if (Status s = detail::validate(target, *batches[k]); !s) {
+            if (batches.size() == 1) return s.error();
+            return Error{"execute_sequence: batch " + std::to_string(k) + ": " + s.error().message};
+        }
+    }
     const int threads = detail::effective_threads(options.threads);
-    // Buffers kept from one batch to the next on this thread (capacity only: every list is
-    // emptied before use, so no result depends on an earlier batch). CULLIDE issues thousands of
+    // Buffers kept from one call to the next on this thread (capacity only: every list is
+    // emptied before use, so no result depends on an earlier call). CULLIDE issues thousands of
     // small batches per frame; allocating these afresh each time returned memory to the kernel and
     // faulted it back in, serial work that made 2 threads slower than 1 (perf, issue #17).
     struct Scratch {
@@ -492,43 +511,62 @@ Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, con
     };
     thread_local Scratch scratch;
     Draws& draw_list = scratch.draw_list;
-    draws(batch, draw_list);
-    share_setup(target, batch, draw_list, scratch.setup, scratch.setup_index);
-    front_end(target, batch, draw_list, threads, scratch.setup, scratch.piece_out);
+    // One front end for the whole sequence: a triangle list is set up once for every draw of any
+    // batch with the same spans and front-end state (share_setup). Every batch's spans are alive
+    // and unchanged for the whole call (the lifetime rule of raster/types.h), so this is exact.
+    draws(batches, draw_list);
+    share_setup(target, draw_list, scratch.setup, scratch.setup_index);
+    front_end(target, draw_list, threads, scratch.setup, scratch.piece_out);
     const SetupDraws& setup = scratch.setup;
     const Tiles tiles{(target.width() + kTileSize - 1) / kTileSize, (target.height() + kTileSize - 1) / kTileSize};
-    bin(setup, draw_list.cmds.size(), tiles, threads, scratch.bins);
-    const std::vector<std::vector<Ref>>& bins = scratch.bins;
-
-    // Back end: one task per tile.
-    const std::size_t n_queries = batch.query_kinds().size();
-    if (scratch.answered.size() < n_queries + 1) scratch.answered = std::vector<std::atomic<bool>>(n_queries + 1);
-    for (std::size_t q = 0; q <= n_queries; ++q) scratch.answered[q].store(false, std::memory_order_relaxed);
-    if (options.written_tiles != nullptr && options.written_tiles->size() != tiles.count())
-        options.written_tiles->assign(tiles.count(), 0);
     static_assert(kTileSize == detail::kHizTile, "HizTile holds the 8 x 8 blocks of one executor tile");
     const bool hiz = options.hierarchical_z && hiz_allowed_by_environment() && target.format() != DepthFormat::D32F;
     if (hiz && scratch.hiz_tiles.size() < tiles.count()) scratch.hiz_tiles.resize(tiles.count());
-    draw_infos(batch, draw_list, setup, target.format(), options.allow_simd, hiz, scratch.infos);
-    const ShadeContext ctx{batch,          draw_list,       setup,          scratch.infos.data(),
-                           {target.mutable_values().data(), target.width()},
-                           target.width(), target.height(), target.format(),
-                           options.allow_simd, hiz, scratch.hiz_tiles.data(),
-                           options.written_tiles != nullptr ? options.written_tiles->data() : nullptr,
-                           scratch.answered.data()};
-    auto& tile_counts = scratch.tile_counts;
-    reset_lists(tile_counts, tiles.count());
-    detail::parallel_for(threads, tiles.count(), [&](std::size_t tile) {
-        const int tx = static_cast<int>(tile % static_cast<std::size_t>(tiles.x));
-        const int ty = static_cast<int>(tile / static_cast<std::size_t>(tiles.x));
-        shade(ctx, tx, ty, bins[tile], tile_counts[tile]);
-    });
 
-    QueryResults results(n_queries, 0);
-    for (std::size_t tile = 0; tile < tiles.count(); ++tile)
-        for (const auto& [q, n] : tile_counts[tile]) results[q] += n;
-    finish_results(batch, results);
-    return results;
+    std::vector<QueryResults> all_results;
+    all_results.reserve(batches.size());
+    for (std::size_t k = 0; k < batches.size(); ++k) {
+        if (k > 0 && between) between(k);
+        const CommandBatch& batch = *batches[k];
+        const std::size_t d0 = draw_list.first[k], d1 = draw_list.first[k + 1];
+        bin(setup, d0, d1, tiles, threads, scratch.bins);
+        const std::vector<std::vector<Ref>>& bins = scratch.bins;
+
+        // Back end: one task per tile.
+        const std::size_t n_queries = batch.query_kinds().size();
+        if (scratch.answered.size() < n_queries + 1) scratch.answered = std::vector<std::atomic<bool>>(n_queries + 1);
+        for (std::size_t q = 0; q <= n_queries; ++q) scratch.answered[q].store(false, std::memory_order_relaxed);
+        if (options.written_tiles != nullptr && options.written_tiles->size() != tiles.count())
+            options.written_tiles->assign(tiles.count(), 0);
+        draw_infos(batch, draw_list, d0, d1, setup, target.format(), options.allow_simd, hiz, scratch.infos);
+        const ShadeContext ctx{draw_list,      setup,           scratch.infos.data(),
+                               {target.mutable_values().data(), target.width()},
+                               target.width(), target.height(), target.format(),
+                               options.allow_simd, hiz, scratch.hiz_tiles.data(),
+                               options.written_tiles != nullptr ? options.written_tiles->data() : nullptr,
+                               scratch.answered.data()};
+        auto& tile_counts = scratch.tile_counts;
+        reset_lists(tile_counts, tiles.count());
+        detail::parallel_for(threads, tiles.count(), [&](std::size_t tile) {
+            const int tx = static_cast<int>(tile % static_cast<std::size_t>(tiles.x));
+            const int ty = static_cast<int>(tile / static_cast<std::size_t>(tiles.x));
+            shade(ctx, tx, ty, bins[tile], tile_counts[tile]);
+        });
+
+        QueryResults results(n_queries, 0);
+        for (std::size_t tile = 0; tile < tiles.count(); ++tile)
+            for (const auto& [q, n] : tile_counts[tile]) results[q] += n;
+        finish_results(batch, results);
+        all_results.push_back(std::move(results));
+    }
+    return all_results;
+}
+
+Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch, const ExecuteOptions& options) {
+    const CommandBatch* const one[1] = {&batch};
+    Result<std::vector<QueryResults>> r = execute_sequence(target, one, options);
+    if (!r) return r.error();
+    return std::move(r.value()[0]);
 }
 
 }  // namespace raster

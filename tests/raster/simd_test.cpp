@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "pipeline.h"
@@ -693,4 +694,95 @@ TEST_CASE("draws that share geometry but not culling: tiled executor == referenc
         }
     }
     CHECK(culled_differently > 50);
+}
+
+// raster::execute_sequence: the front end is shared by every batch of the sequence (share_setup
+// over all their draws). Random scenes; each sequence holds batches that draw the same spans (some
+// with other culling, depth state or order, as CULLIDE's two passes do) and a clear between them;
+// results and every bit equal execute() per batch with the same clear, for 1, 2 and 3 threads.
+TEST_CASE("execute_sequence == execute per batch with the clear between, and an invalid batch runs nothing") {
+    raster_test::SplitMix64 rng(0x5e9u);
+    const int w = 140, h = 100;
+    for (int rep = 0; rep < 8; ++rep) {
+        std::vector<raster::Float4> v;
+        std::vector<std::uint32_t> idx;
+        for (int t = 0; t < 40; ++t) {
+            const float cx = static_cast<float>(rng.uniform(-1.1, 1.1)), cy = static_cast<float>(rng.uniform(-1.1, 1.1));
+            const float r = static_cast<float>(rng.uniform(0.02, 0.5));
+            for (int k = 0; k < 3; ++k) {
+                idx.push_back(static_cast<std::uint32_t>(v.size()));
+                v.push_back({cx + static_cast<float>(rng.uniform(-r, r)), cy + static_cast<float>(rng.uniform(-r, r)),
+                             static_cast<float>(rng.uniform(-1.3, 1.3)), 1.0f});
+            }
+        }
+        // Items: runs of 6 indices (two triangles) of the one index list.
+        std::vector<std::span<const std::uint32_t>> items;
+        for (std::size_t k = 0; k + 6 <= idx.size(); k += 6) items.push_back(std::span<const std::uint32_t>(idx).subspan(k, 6));
+        std::vector<raster::CommandBatch> batches;
+        for (int b = 0; b < 3; ++b) {
+            raster::CommandBatch batch(w, h);
+            const bool backward = b == 1;
+            for (std::size_t n = 0; n < items.size(); ++n) {
+                const auto& item = items[backward ? items.size() - 1 - n : n];
+                raster::DrawState q;
+                q.depth_func = DepthFunc::GEqual;
+                q.depth_write = false;
+                q.cull_face = b == 2 ? raster::CullFace::Front : raster::CullFace::None;
+                batch.begin_query(raster::QueryKind::AnySamplesPassed);
+                batch.draw(raster::MeshView{v, item}, q);
+                batch.end_query();
+                raster::DrawState wr;
+                wr.cull_face = b == 2 ? raster::CullFace::Back : raster::CullFace::None;
+                batch.draw(raster::MeshView{v, item}, wr);
+            }
+            batches.push_back(std::move(batch));
+        }
+        std::vector<const raster::CommandBatch*> ptrs;
+        for (const auto& b : batches) ptrs.push_back(&b);
+        for (const auto f : kFormats) {
+            // Want: execute per batch, the target cleared to 1 before each.
+            auto want_t = raster::DepthTarget::create(w, h, f).value();
+            std::vector<raster::QueryResults> want;
+            std::vector<std::vector<std::uint32_t>> want_depth;
+            for (const auto& b : batches) {
+                REQUIRE(want_t.clear(1.0).ok());
+                auto r = raster::execute(want_t, b, raster::ExecuteOptions{1, false});
+                REQUIRE(r.ok());
+                want.push_back(r.value());
+                want_depth.emplace_back(want_t.values().begin(), want_t.values().end());
+            }
+            for (const int threads : {1, 2, 3}) {
+                CAPTURE(rep);
+                CAPTURE(static_cast<int>(f));
+                CAPTURE(threads);
+                auto t = raster::DepthTarget::create(w, h, f).value();
+                std::vector<std::vector<std::uint32_t>> depth_before_clear;
+                std::size_t calls = 0;
+                const auto got = raster::execute_sequence(t, ptrs, raster::ExecuteOptions{threads, true}, [&](std::size_t k) {
+                    CHECK(k == calls + 1);
+                    ++calls;
+                    depth_before_clear.emplace_back(t.values().begin(), t.values().end());
+                    REQUIRE(t.clear(1.0).ok());
+                });
+                REQUIRE(got.ok());
+                CHECK(calls == 2);
+                CHECK(got.value() == want);
+                depth_before_clear.emplace_back(t.values().begin(), t.values().end());
+                CHECK(depth_before_clear == want_depth);
+            }
+        }
+    }
+    // An invalid later batch: nothing runs, the error names it.
+    std::vector<raster::Float4> v = {{-0.5f, -0.5f, 0.0f, 1.0f}, {0.5f, -0.5f, 0.0f, 1.0f}, {0.0f, 0.5f, 0.0f, 1.0f}};
+    const std::vector<std::uint32_t> good = {0, 1, 2}, bad = {0, 1, 5};
+    raster::CommandBatch a(32, 32), b(32, 32);
+    a.draw(raster::MeshView{v, good}, {});
+    b.draw(raster::MeshView{v, bad}, {});
+    auto t = raster::DepthTarget::create(32, 32, DepthFormat::D24).value();
+    const std::vector<std::uint32_t> before(t.values().begin(), t.values().end());
+    const raster::CommandBatch* const seq[2] = {&a, &b};
+    const auto r = raster::execute_sequence(t, seq, {}, [](std::size_t) { FAIL("between() must not run"); });
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().message.find("batch 1: command 0: index 5") != std::string::npos);
+    CHECK(std::equal(before.begin(), before.end(), t.values().begin(), t.values().end()));
 }

@@ -10,6 +10,8 @@
 //    clears it to depth 1.0 (glClearDepth(1); glClear); the target may be reused between calls;
 //  - execute(batch) runs every command of the batch in order on the current target and returns
 //    the query results indexed like the batch's begin_query() calls (raster/command_batch.h);
+//  - execute_cleared(width, height, format, batches) runs each batch on a cleared target, as clear
+//    and execute per batch would (a device may share work between the batches);
 //  - visibility_pass(size, format, items) answers CULLIDE's two exact-bounds passes of one view
 //    (raster/visibility.h). Every device can: the base class records the two passes and runs them
 //    with clear and execute (recorded_visibility_pass); the emulator answers them natively with
@@ -44,6 +46,14 @@ class QueryDevice {
     [[nodiscard]] virtual Result<raster::QueryResults> execute(const raster::CommandBatch& batch) = 0;
     // For reports: "emulator", "osmesa (llvmpipe ...)".
     [[nodiscard]] virtual std::string name() const = 0;
+
+    // Each batch on a freshly cleared width x height target of `format`, in order: the results of
+    // clear then execute for each batch in turn (the default does exactly that). All batches are
+    // recorded before the call, so a device may share work between them: the emulator sets each
+    // triangle up once for all of them (raster::execute_sequence). Fails as clear and execute fail;
+    // the emulator validates every batch before running any.
+    [[nodiscard]] virtual Result<std::vector<raster::QueryResults>> execute_cleared(
+        int width, int height, raster::DepthFormat format, std::span<const raster::CommandBatch* const> batches);
 
     // For each item, 1 when one of its two recorded queries passes a sample, 0 when it is fully
     // visible with respect to every other object's items (raster/visibility.h), on a target of

@@ -2,7 +2,10 @@
 // Conventions: raster/raster.h.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <span>
 #include <vector>
 
 #include "raster/depth_target.h"
@@ -92,6 +95,21 @@ using QueryResults = std::vector<std::uint64_t>;
 // counters are summed in tile order. Bit-identical to execute_reference for any thread count.
 [[nodiscard]] Result<QueryResults> execute(DepthTarget& target, const CommandBatch& batch,
                                            const ExecuteOptions& options = {});
+
+// Several batches on one target, in order: the same results, bits and errors as calling
+// between(k) before batch k (k >= 1) and execute(target, *batches[k], options) for each in turn,
+// with two differences. All batches are validated first: if one is invalid, none runs (the error
+// names it). And the triangle setup (clipping, snapping, edge functions, depth planes) of a draw is
+// done once for every draw of any batch with the same vertex and index spans and front-end state
+// (viewport, facing, rules; culling is applied per draw). CULLIDE's two passes of a view draw the
+// same items in opposite orders, each pass on a cleared target: as one sequence they share their
+// setup. Every batch's spans must be alive and unchanged for the whole call (the rule of
+// raster/types.h). `between` may change the target's depth values (a clear, for instance) but not
+// its size or format.
+[[nodiscard]] Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target,
+                                                                 std::span<const CommandBatch* const> batches,
+                                                                 const ExecuteOptions& options = {},
+                                                                 const std::function<void(std::size_t)>& between = {});
 
 // The scalar reference: commands one by one, each triangle over its whole bounding box, on one
 // thread (options.threads is ignored; allow_simd is honoured).
