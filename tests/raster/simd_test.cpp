@@ -44,6 +44,17 @@ std::uint32_t random_stored(raster_test::SplitMix64& rng, DepthFormat f, float n
     return 0;
 }
 
+// Front-end parameters of a whole w x h target: no culling, GL's counter-clockwise front faces.
+detail::FrontEndParams whole_target(int w, int h) {
+    detail::FrontEndParams p{};
+    p.target_width = w;
+    p.target_height = h;
+    p.viewport = raster::Viewport{0, 0, w, h};
+    p.cull_face = raster::CullFace::None;
+    p.front_face = raster::FrontFace::CCW;
+    return p;
+}
+
 }  // namespace
 
 TEST_CASE("AVX2 kernel == portable kernel on random triangles, rectangles and stored depths (every format, function, mask)") {
@@ -54,12 +65,7 @@ TEST_CASE("AVX2 kernel == portable kernel on random triangles, rectangles and st
     std::uint64_t total_passed = 0, compared = 0, rejected_rects = 0;
     for (const auto& sz : sizes) {
         const int w = sz[0], h = sz[1];
-        detail::FrontEndParams p{};
-        p.target_width = w;
-        p.target_height = h;
-        p.viewport = raster::Viewport{0, 0, w, h};
-        p.cull_face = raster::CullFace::None;
-        p.front_face = raster::FrontFace::CCW;
+        detail::FrontEndParams p = whole_target(w, h);
         for (int n = 0; n < 220; ++n) {
             std::vector<detail::SetupTri> tris;
             const int flavour = static_cast<int>(rng.below(5));
@@ -314,12 +320,7 @@ TEST_CASE("row spans (AVX2 walk, portable division) and shrink_rect == the per-p
     std::uint64_t rects = 0, covered_total = 0, shrunk = 0, emptied = 0;
     for (const auto& sz : sizes) {
         const int w = sz[0], h = sz[1];
-        detail::FrontEndParams p{};
-        p.target_width = w;
-        p.target_height = h;
-        p.viewport = raster::Viewport{0, 0, w, h};
-        p.cull_face = raster::CullFace::None;
-        p.front_face = raster::FrontFace::CCW;
+        detail::FrontEndParams p = whole_target(w, h);
         std::vector<std::uint32_t> a(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), kSentinel), b = a;
         for (int n = 0; n < 1500; ++n) {
             std::vector<detail::SetupTri> tris;
@@ -520,12 +521,7 @@ TEST_CASE("SetupTri::fits32 holds: every edge value over the box widened by 7 co
     raster_test::SplitMix64 rng(0xf175u);
     std::uint64_t flagged = 0, unflagged = 0;
     for (const int side : {64, 1024, 16384}) {
-        detail::FrontEndParams p{};
-        p.target_width = side;
-        p.target_height = side;
-        p.viewport = raster::Viewport{0, 0, side, side};
-        p.cull_face = raster::CullFace::None;
-        p.front_face = raster::FrontFace::CCW;
+        detail::FrontEndParams p = whole_target(side, side);
         for (int n = 0; n < 3000; ++n) {
             raster::Float4 v[3];
             const float spread = rng.chance(50) ? rng.uniform(0.0f, 0.05f) : rng.uniform(0.0f, 3.0f);
@@ -575,12 +571,7 @@ TEST_CASE("window positions out of the fixed-point range: setup drops the triang
     const raster::Float4 plain[3] = {{-0.9f, -0.9f, 0.2f, 1.0f}, {0.9f, -0.8f, -0.1f, 1.0f}, {0.1f, 0.9f, 0.4f, 1.0f}};
     const int w = 94, h = 96;
 
-    detail::FrontEndParams p{};
-    p.target_width = w;
-    p.target_height = h;
-    p.viewport = raster::Viewport{0, 0, w, h};
-    p.cull_face = raster::CullFace::None;
-    p.front_face = raster::FrontFace::CCW;
+    detail::FrontEndParams p = whole_target(w, h);
     p.rules = raster::RasterRules::GlLlvmpipe;  // (the Vulkan rules clip these at z >= 0 instead)
     // The first clips to a fan of two: one in range (kept) and one with the NaN vertex (dropped);
     // the second's fan is out of range as a whole; the plain one is kept.
