@@ -493,6 +493,17 @@ Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::spa
             return Error{"execute_sequence: batch " + std::to_string(k) + ": " + s.error().message};
         }
     }
+    // The buffers below are this thread's: a call from inside `between` would overwrite the
+    // running sequence's front end. Refused instead (raster/command_batch.h).
+    thread_local bool running = false;
+    if (running) return Error{"execute_sequence: execute or execute_sequence called from a between() callback"};
+    struct Running {
+        bool& flag;
+        explicit Running(bool& f) : flag(f) { flag = true; }
+        ~Running() { flag = false; }
+        Running(const Running&) = delete;
+        Running& operator=(const Running&) = delete;
+    } running_scope(running);
     const int threads = detail::effective_threads(options.threads);
     // Buffers kept from one call to the next on this thread (capacity only: every list is
     // emptied before use, so no result depends on an earlier call). CULLIDE issues thousands of

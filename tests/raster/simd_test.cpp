@@ -776,4 +776,20 @@ TEST_CASE("execute_sequence == execute per batch with the clear between, and an 
     REQUIRE_FALSE(r.ok());
     CHECK(r.error().message.find("batch 1: command 0: index 5") != std::string::npos);
     CHECK(std::equal(before.begin(), before.end(), t.values().begin(), t.values().end()));
+    // A nested call from between() is refused (it would reuse the running sequence's buffers),
+    // and the outer sequence still gives execute()'s answers.
+    const raster::CommandBatch* const twice[2] = {&a, &a};
+    auto other = raster::DepthTarget::create(32, 32, DepthFormat::D24).value();
+    bool refused = false;
+    const auto outer = raster::execute_sequence(t, twice, {}, [&](std::size_t) {
+        const auto inner = raster::execute(other, a);
+        refused = !inner.ok() && inner.error().message.find("between() callback") != std::string::npos;
+    });
+    REQUIRE(outer.ok());
+    CHECK(refused);
+    auto want_t = raster::DepthTarget::create(32, 32, DepthFormat::D24).value();
+    const auto want = raster::execute(want_t, a);
+    REQUIRE(want.ok());
+    REQUIRE(outer.value().size() == 2);
+    CHECK(outer.value()[1] == want.value());
 }

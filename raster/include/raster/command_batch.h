@@ -105,7 +105,7 @@ using QueryResults = std::vector<std::uint64_t>;
 // same items in opposite orders, each pass on a cleared target: as one sequence they share their
 // setup. Every batch's spans must be alive and unchanged for the whole call (the rule of
 // raster/types.h). `between` may change the target's depth values (a clear, for instance) but not
-// its size or format.
+// its size or format, and may not call execute or execute_sequence (refused with an error).
 [[nodiscard]] Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target,
                                                                  std::span<const CommandBatch* const> batches,
                                                                  const ExecuteOptions& options = {},
