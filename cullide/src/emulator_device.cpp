@@ -60,25 +60,26 @@ Status EmulatorDevice::clear(int width, int height, raster::DepthFormat format) 
     return Status{};
 }
 
+raster::ExecuteOptions EmulatorDevice::execute_options() {
+    raster::ExecuteOptions eo;
+    eo.threads = threads_;
+    eo.written_tiles = &written_tiles_;  // the tiles the next clear restores
+    return eo;
+}
+
 Result<std::vector<raster::QueryResults>> EmulatorDevice::execute_cleared(
     int width, int height, raster::DepthFormat format, std::span<const raster::CommandBatch* const> batches) {
     if (Status s = clear(width, height, format); !s) return s.error();
-    raster::ExecuteOptions eo;
-    eo.threads = threads_;
-    eo.written_tiles = &written_tiles_;
     // Between batches the same partial clear as clear() (the size and format are already right).
     raster::Result<std::vector<raster::QueryResults>> r = raster::execute_sequence(
-        *target_, batches, eo, [&](std::size_t) { (void)clear(width, height, format); });
+        *target_, batches, execute_options(), [&](std::size_t) { (void)clear(width, height, format); });
     if (!r) return Error{"emulator device: " + r.error().message};
     return std::move(r).value();
 }
 
 Result<raster::QueryResults> EmulatorDevice::execute(const raster::CommandBatch& batch) {
     if (!target_) return Error{"emulator device: execute before clear (no depth target yet)"};
-    raster::ExecuteOptions eo;
-    eo.threads = threads_;
-    eo.written_tiles = &written_tiles_;  // the tiles the next clear restores
-    raster::Result<raster::QueryResults> r = raster::execute(*target_, batch, eo);
+    raster::Result<raster::QueryResults> r = raster::execute(*target_, batch, execute_options());
     // A failed batch was rejected before anything was drawn (raster/raster.h).
     if (!r) return Error{"emulator device: " + r.error().message};
     return std::move(r).value();

@@ -37,6 +37,10 @@ class EmulatorDevice final : public QueryDevice {
     [[nodiscard]] const raster::DepthTarget* target() const { return target_ ? &*target_ : nullptr; }
 
    private:
+    // The executor's options for this device: its thread count, and the written tiles the next
+    // clear restores.
+    raster::ExecuteOptions execute_options();
+
     int threads_;
     std::optional<raster::DepthTarget> target_;
     // Per 64 x 64 tile of the target (raster::kExecuteTileSize, row-major, tiles_x_ per row): 1 when

@@ -1,7 +1,8 @@
-// query_device.cpp: what every QueryDevice can do through clear and execute (the recorded
-// visibility pass).
+// query_device.cpp: what every QueryDevice can do through clear and execute (execute_cleared and
+// the recorded visibility pass).
 #include "cullide/query_device.h"
 
+#include <array>
 #include <string>
 #include <utility>
 
@@ -44,27 +45,36 @@ Result<std::vector<std::uint8_t>> QueryDevice::recorded_visibility_pass(
     write_state.depth_func = raster::DepthFunc::LEqual;
     write_state.depth_write = true;
 
-    std::vector<std::uint8_t> passed(items.size(), 0);
-    std::vector<std::uint32_t> query(items.size());
+    // Both passes recorded, then run with execute_cleared (each on a cleared target).
+    std::array<raster::CommandBatch, 2> batches = {raster::CommandBatch(size.width(), size.height()),
+                                                   raster::CommandBatch(size.width(), size.height())};
+    std::array<std::vector<std::uint32_t>, 2> query;
     for (int pass = 0; pass < 2; ++pass) {  // pass 1 forward, pass 2 backward
-        raster::CommandBatch batch(size.width(), size.height());
+        raster::CommandBatch& batch = batches[static_cast<std::size_t>(pass)];
+        std::vector<std::uint32_t>& q = query[static_cast<std::size_t>(pass)];
+        q.resize(items.size());
         for (std::size_t k = 0; k < objects.size(); ++k) {
             const auto [begin, end] = objects[pass == 0 ? k : objects.size() - 1 - k];
             for (std::size_t i = begin; i < end; ++i) {
-                query[i] = batch.begin_query(raster::QueryKind::AnySamplesPassed);
+                q[i] = batch.begin_query(raster::QueryKind::AnySamplesPassed);
                 batch.draw(items[i].mesh, query_state);
                 batch.end_query();
             }
             if (k + 1 == objects.size()) continue;  // nothing is queried after the last object
             for (std::size_t i = begin; i < end; ++i) batch.draw(items[i].mesh, write_state);
         }
-        if (Status s = clear(size.width(), size.height(), format); !s) return s.error();
-        Result<raster::QueryResults> r = execute(batch);
-        if (!r) return r.error();
-        if (r.value().size() != batch.query_kinds().size())
-            return Error{name() + " returned " + std::to_string(r.value().size()) + " query results for " +
-                         std::to_string(batch.query_kinds().size()) + " queries"};
-        for (std::size_t i = 0; i < items.size(); ++i) passed[i] |= r.value()[query[i]] != 0 ? 1 : 0;
+    }
+    const raster::CommandBatch* const both[2] = {&batches[0], &batches[1]};
+    Result<std::vector<raster::QueryResults>> r = execute_cleared(size.width(), size.height(), format, both);
+    if (!r) return r.error();
+    if (r.value().size() != 2) return Error{name() + " returned " + std::to_string(r.value().size()) + " passes for 2"};
+    std::vector<std::uint8_t> passed(items.size(), 0);
+    for (std::size_t pass = 0; pass < 2; ++pass) {
+        const raster::QueryResults& res = r.value()[pass];
+        if (res.size() != batches[pass].query_kinds().size())
+            return Error{name() + " returned " + std::to_string(res.size()) + " query results for " +
+                         std::to_string(batches[pass].query_kinds().size()) + " queries"};
+        for (std::size_t i = 0; i < items.size(); ++i) passed[i] |= res[query[pass][i]] != 0 ? 1 : 0;
     }
     return passed;
 }

@@ -98,15 +98,12 @@ void append_box(OffsetMesh& out, const std::array<Float4, 8>& corners) {
     out.indices.insert(out.indices.end(), idx.begin(), idx.end());
 }
 
-// view_axes (transform.h) with the view's axis order decided once: the function decodes the
-// axis on every call, in another translation unit (2.5% of a leaves / rcullide-offset frame).
+// view_axes (transform.h) with the view's axis order decoded once (view_axis_indices): the
+// function decodes it on every call, in another translation unit (2.5% of a leaves /
+// rcullide-offset frame).
 struct AxisMap {
-    int u, v, d;
-    explicit AxisMap(const OrthoView& view) {
-        d = view.axis == Axis::X ? 0 : (view.axis == Axis::Y ? 1 : 2);
-        u = (d + 1) % 3;
-        v = (d + 2) % 3;
-    }
+    int u = 0, v = 0, d = 0;
+    explicit AxisMap(const OrthoView& view) { view_axis_indices(view.axis, u, v, d); }
     [[nodiscard]] Double3 operator()(const Double3& p) const {
         const double c[3] = {p.x, p.y, p.z};
         return Double3{c[u], c[v], c[d]};

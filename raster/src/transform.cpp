@@ -78,14 +78,13 @@ namespace {
 double& axis_ref(Double3& p, int k) { return k == 0 ? p.x : (k == 1 ? p.y : p.z); }
 double axis_of(const Double3& p, int k) { return k == 0 ? p.x : (k == 1 ? p.y : p.z); }
 
-// The world axis index that becomes screen u, v and depth d (a cyclic permutation of x, y, z).
+}  // namespace
+
 void view_axis_indices(Axis axis, int& u, int& v, int& d) {
     d = axis == Axis::X ? 0 : (axis == Axis::Y ? 1 : 2);
     u = (d + 1) % 3;
     v = (d + 2) % 3;
 }
-
-}  // namespace
 
 Result<OrthoView> make_ortho_view(Axis axis, Double3 box_min, Double3 box_max, int width, int height,
                                   DepthFormat format) {

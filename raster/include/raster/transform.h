@@ -66,6 +66,10 @@ struct OrthoView {
 [[nodiscard]] Result<OrthoView> make_ortho_view(Axis axis, Double3 box_min, Double3 box_max, int width, int height,
                                                 DepthFormat format);
 
+// The world axis index (0 = x, 1 = y, 2 = z) that becomes screen u, v and depth d for `axis`: the
+// cyclic permutation above. For loops over many points, which then need not decode it per point.
+void view_axis_indices(Axis axis, int& u, int& v, int& d);
+
 // World -> (u, v, d) of the view (the cyclic permutation above; exact).
 [[nodiscard]] Double3 view_axes(const OrthoView& view, Double3 world);
 
