@@ -6,11 +6,11 @@
 #
 #   library        TBB (threads; serial executor without it: the embedded configuration)
 #   front door     Eigen (the libigl-style V/F entry points of cullide/eigen.h, header-only)
-#   tests          GMP (rational references), OSMesa, Vulkan (lavapipe) and Embree (oracles), doctest
+#   tests          GMP (rational references), OSMesa, EGL, Vulkan (lavapipe) and Embree (oracles), doctest
 #                  (the runner, needed by CULLIDE_BUILD_TESTS)
 #   benchmarks     Google Benchmark (needed by CULLIDE_BUILD_BENCHMARKS), and the peers FCL, Bullet,
 #                  CGAL (peers_bench, spatialhash_bench)
-# None of OSMesa, Vulkan, Embree, GMP, FCL, Bullet and CGAL is ever linked into a library.
+# None of OSMesa, EGL, Vulkan, Embree, GMP, FCL, Bullet and CGAL is ever linked into a library.
 
 option(CULLIDE_STRICT_DEPS "Fail when a package switched on by CULLIDE_WITH_* is not found" OFF)
 option(CULLIDE_WITH_GMP "Use GMP for the rational references of tests and fuzzers" ON)
@@ -71,6 +71,19 @@ if(Vulkan_FOUND AND CULLIDE_GLSLANG_VALIDATOR)
 endif()
 _cullide_dep(Vulkan "${CULLIDE_WITH_VULKAN}" "${_cullide_vulkan_found}"
              "the Vulkan-rules (lavapipe) conformance checks are skipped")
+
+# EGL: real GL drivers without a window, through glvnd (libegl-dev, libopengl-dev; Mesa's software
+# device, llvmpipe, is libegl-mesa0). The EGL oracle (tests/oracle/egl_device.h) runs
+# tests/raster/driver_report on llvmpipe here, and on a GPU's own driver where one is.
+if(CULLIDE_WITH_EGL)
+  set(OpenGL_GL_PREFERENCE GLVND)
+  find_package(OpenGL QUIET COMPONENTS OpenGL EGL)
+endif()
+set(_cullide_egl_found OFF)
+if(TARGET OpenGL::OpenGL AND TARGET OpenGL::EGL)
+  set(_cullide_egl_found ON)
+endif()
+_cullide_dep(EGL "${CULLIDE_WITH_EGL}" "${_cullide_egl_found}" "the EGL (real GL driver) reports are not built")
 
 if(CULLIDE_WITH_EMBREE)
   find_package(embree 3 QUIET)

@@ -32,7 +32,7 @@ fi
 if [ ! -f "$build/CMakeCache.txt" ]; then
   cmake -S . -B "$build" -G Ninja -DCMAKE_TOOLCHAIN_FILE="$root/cmake/toolchain-aarch64.cmake" \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCULLIDE_WERROR=ON \
-    -DCULLIDE_WITH_TBB=OFF -DCULLIDE_WITH_OSMESA=OFF -DCULLIDE_WITH_VULKAN=OFF -DCULLIDE_WITH_EMBREE=OFF \
+    -DCULLIDE_WITH_TBB=OFF -DCULLIDE_WITH_OSMESA=OFF -DCULLIDE_WITH_EGL=OFF -DCULLIDE_WITH_VULKAN=OFF -DCULLIDE_WITH_EMBREE=OFF \
     -DCULLIDE_BUILD_BENCHMARKS=OFF >/dev/null
 fi
 # The configuration must really be the cross one (a stale host cache would test x86-64 instead).

@@ -3,7 +3,8 @@
 # usage: scripts/deps.sh run|test|fuzz|bench
 #   run   what the library and the CLI need (oneTBB; the build tools)
 #   test  + the test and benchmark dependencies and the oracles (Eigen for the Eigen front door,
-#         doctest, GMP, OSMesa, Vulkan with lavapipe and glslang, Embree, Benchmark)
+#         doctest, GMP, OSMesa, EGL with Mesa's software device, Vulkan with lavapipe and glslang,
+#         Embree, Benchmark)
 #   fuzz  + clang with libFuzzer
 #   bench + the peers of peers_bench (FCL, Bullet, CGAL) and matplotlib for scripts/plots.py and
 #         scripts/plot_spatialhash.py (FCL and Bullet are also spatialhash_bench's peers)
@@ -13,9 +14,9 @@ set -euo pipefail
 want=(cmake ninja-build g++ pkg-config libtbb-dev)
 case "${1:-run}" in
   run) ;;
-  test) want+=(libeigen3-dev doctest-dev libgmp-dev libosmesa6-dev libvulkan-dev glslang-tools mesa-vulkan-drivers libembree-dev libbenchmark-dev) ;;
-  fuzz) want+=(libeigen3-dev doctest-dev libgmp-dev libosmesa6-dev libvulkan-dev glslang-tools mesa-vulkan-drivers libembree-dev libbenchmark-dev clang libclang-rt-14-dev) ;;
-  bench) want+=(libeigen3-dev doctest-dev libgmp-dev libosmesa6-dev libvulkan-dev glslang-tools mesa-vulkan-drivers libembree-dev libbenchmark-dev libfcl-dev libbullet-dev
+  test) want+=(libeigen3-dev doctest-dev libgmp-dev libosmesa6-dev libegl-dev libopengl-dev libegl-mesa0 libvulkan-dev glslang-tools mesa-vulkan-drivers libembree-dev libbenchmark-dev) ;;
+  fuzz) want+=(libeigen3-dev doctest-dev libgmp-dev libosmesa6-dev libegl-dev libopengl-dev libegl-mesa0 libvulkan-dev glslang-tools mesa-vulkan-drivers libembree-dev libbenchmark-dev clang libclang-rt-14-dev) ;;
+  bench) want+=(libeigen3-dev doctest-dev libgmp-dev libosmesa6-dev libegl-dev libopengl-dev libegl-mesa0 libvulkan-dev glslang-tools mesa-vulkan-drivers libembree-dev libbenchmark-dev libfcl-dev libbullet-dev
                libcgal-dev python3-matplotlib) ;;
   *) echo "usage: $0 run|test|fuzz|bench" >&2; exit 2 ;;
 esac

@@ -6,7 +6,7 @@
 #       (fuzz/corpus/<target>/). A finding fails the run and leaves its input in build-fuzz/findings/.
 #
 #   scripts/fuzz.sh campaign [--budget S] [--jobs N] [--targets LIST] [--dir D] [--fast]
-#                            [--ledger FILE] [--note TEXT] [--timeout S]
+#                            [--ledger FILE] [--note TEXT] [--timeout S] [--prebuilt]
 #       A campaign: every target (or LIST, comma separated) in turn, for an even share of a wall-clock
 #       budget of S seconds (default 3600), each as N libFuzzer processes (-fork=N, default: every core)
 #       over a corpus that persists between campaigns (D/corpus/<target>, seeded from fuzz/corpus/).
@@ -18,6 +18,10 @@
 #       coverage-only build (no ASan/UBSan; every target still checks its own property against its
 #       reference), several times faster; the default build has ASan + UBSan like CI's.
 #       D defaults to build-fuzz/campaign (build-fuzz-fast/campaign with --fast).
+#       --prebuilt runs the targets already in the build folder, with no deps.sh and no cmake: for a
+#       machine without the toolchain (a lent machine with more cores, the binaries and libtbb
+#       carried there). The ledger's commit is then CULLIDE_FUZZ_COMMIT where git is missing; the
+#       binaries must have been built from it.
 #
 #   scripts/fuzz.sh ledger [FILE]
 #       The ledger's totals per target (executions, seconds, runs, findings, last coverage), as the
@@ -111,7 +115,7 @@ smoke() {
 }
 
 campaign() {
-  local budget=3600 jobs targets="" dir="" fast=0 ledger="$root/fuzz/ledger.csv" note="" timeout=120
+  local budget=3600 jobs targets="" dir="" fast=0 ledger="$root/fuzz/ledger.csv" note="" timeout=120 prebuilt=0
   jobs="$(nproc)"
   while [ $# -gt 0 ]; do
     case "$1" in
@@ -123,6 +127,7 @@ campaign() {
       --ledger) ledger="${2:?--ledger needs a file}"; shift 2 ;;
       --note) note="${2:?--note needs text}"; shift 2 ;;
       --timeout) timeout="${2:?--timeout needs seconds}"; shift 2 ;;
+      --prebuilt) prebuilt=1; shift ;;
       *) die "campaign: unknown option '$1' (see the usage at the top of scripts/fuzz.sh)" ;;
     esac
   done
@@ -135,7 +140,7 @@ campaign() {
   if [ "$fast" = 1 ]; then build="$root/build-fuzz-fast"; sanitize=""; kind="coverage-only"
   else build="$root/build-fuzz"; sanitize="address,undefined"; kind="asan-ubsan"; fi
   [ -n "$dir" ] || dir="$build/campaign"
-  build_fuzzers "$build" "$sanitize"
+  [ "$prebuilt" = 1 ] || build_fuzzers "$build" "$sanitize"
 
   local all=() exe name
   for exe in "$build"/bin/*_fuzz; do [ -x "$exe" ] && all+=("$(basename "$exe" _fuzz)"); done
@@ -155,7 +160,7 @@ campaign() {
   mkdir -p "$dir/findings" "$dir/logs" "$(dirname "$ledger")"
   [ -f "$ledger" ] || echo "date_utc,commit,target,build,jobs,seconds,executions,exec_per_s,cov,ft,corpus,crashes,timeouts,ooms,load_start,load_end,cores,note" >"$ledger"
   local commit
-  commit="$(git rev-parse --short=12 HEAD 2>/dev/null || echo unknown)"
+  commit="$(git rev-parse --short=12 HEAD 2>/dev/null || echo "${CULLIDE_FUZZ_COMMIT:-unknown}")"
   # Dirty means changed code: the ledger's own earlier rows (a campaign of several runs writes it)
   # do not count.
   local ledger_rel

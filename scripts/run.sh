@@ -10,7 +10,7 @@ build="$root/build-release"
 if [ ! -f "$build/CMakeCache.txt" ]; then
   cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCULLIDE_BUILD_TESTS=OFF \
     -DCULLIDE_BUILD_BENCHMARKS=OFF -DCULLIDE_STRICT_DEPS=ON -DCULLIDE_WITH_TBB=ON -DCULLIDE_WITH_EIGEN=OFF \
-    -DCULLIDE_WITH_GMP=OFF -DCULLIDE_WITH_OSMESA=OFF -DCULLIDE_WITH_EMBREE=OFF >/dev/null
+    -DCULLIDE_WITH_GMP=OFF -DCULLIDE_WITH_OSMESA=OFF -DCULLIDE_WITH_EGL=OFF -DCULLIDE_WITH_VULKAN=OFF -DCULLIDE_WITH_EMBREE=OFF >/dev/null
 fi
 if ! cmake --build "$build" --target cullide_cli -j"$(nproc)" > "$build/build.log" 2>&1; then
   cat "$build/build.log" >&2

@@ -60,7 +60,7 @@ if [ -f "$build/CMakeCache.txt" ] && ! grep -q "^TBB_DIR:[A-Z]*=$tbb_dir\$" "$bu
 fi
 if [ ! -f "$build/CMakeCache.txt" ]; then
   cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCULLIDE_WERROR=ON \
-    -DCULLIDE_SANITIZE=thread -DCULLIDE_WITH_OSMESA=OFF -DCULLIDE_WITH_VULKAN=OFF -DCULLIDE_WITH_EMBREE=OFF \
+    -DCULLIDE_SANITIZE=thread -DCULLIDE_WITH_OSMESA=OFF -DCULLIDE_WITH_EGL=OFF -DCULLIDE_WITH_VULKAN=OFF -DCULLIDE_WITH_EMBREE=OFF \
     -DCULLIDE_BUILD_BENCHMARKS=OFF -DTBB_DIR="$tbb_dir" >/dev/null
 fi
 grep -q "^TBB_DIR:[A-Z]*=$tbb_dir\$" "$build/CMakeCache.txt" || {

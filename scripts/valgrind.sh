@@ -29,7 +29,7 @@ fi
 build="${CULLIDE_VALGRIND_BUILD:-$root/build-embedded}"
 if [ ! -f "$build/CMakeCache.txt" ]; then
   cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCULLIDE_WERROR=ON \
-    -DCULLIDE_WITH_TBB=OFF -DCULLIDE_WITH_OSMESA=OFF -DCULLIDE_WITH_VULKAN=OFF -DCULLIDE_WITH_EMBREE=OFF -DCULLIDE_BUILD_BENCHMARKS=OFF >/dev/null
+    -DCULLIDE_WITH_TBB=OFF -DCULLIDE_WITH_OSMESA=OFF -DCULLIDE_WITH_EGL=OFF -DCULLIDE_WITH_VULKAN=OFF -DCULLIDE_WITH_EMBREE=OFF -DCULLIDE_BUILD_BENCHMARKS=OFF >/dev/null
 fi
 case "$mode" in
   short) regex='golden digests: (raster|spatial)'; targets=(golden_digest_test cullide_cli) ;;

@@ -1,53 +1,21 @@
-// osmesa_device.cpp: see osmesa_device.h. Facts about OSMesa 22.3.6 used here are in
-// ../shared/docs/toolchain.md section 2 (GL_GLEXT_PROTOTYPES, do not link libGL, glFinish).
-#define GL_GLEXT_PROTOTYPES 1
+// osmesa_device.cpp: see osmesa_device.h. The GL work is gl_batch_runner.cpp's; here is only the
+// OSMesa context. Facts about OSMesa 22.3.6 used here are in ../shared/docs/toolchain.md section 2
+// (do not link libGL; glGetQueryObjectui64v only through OSMesaGetProcAddress).
 #include "osmesa_device.h"
 
 #include <GL/osmesa.h>
 
-#include <cstring>
-#include <map>
-#include <utility>
+#include "gl_batch_runner.h"
 
 namespace cullide_oracle {
 
 struct OsmesaDevice::Impl {
     OSMesaContext ctx = nullptr;
     std::vector<unsigned char> window;  // OSMesa needs a colour buffer to make the context current
-    GLuint fbo = 0, depth_rb = 0, program = 0, vao = 0, vbo = 0, ibo = 0;
+    std::unique_ptr<GlBatchRunner> gl;
+
+    void make_current() { OSMesaMakeCurrent(ctx, window.data(), GL_UNSIGNED_BYTE, 4, 4); }
 };
-
-namespace {
-
-GLuint compile(GLenum type, const char* src, std::string& log) {
-    GLuint s = glCreateShader(type);
-    glShaderSource(s, 1, &src, nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char buf[1024] = {};
-        glGetShaderInfoLog(s, sizeof buf, nullptr, buf);
-        log = buf;
-    }
-    return s;
-}
-
-GLenum gl_func(raster::DepthFunc f) {
-    switch (f) {
-        case raster::DepthFunc::Never: return GL_NEVER;
-        case raster::DepthFunc::Less: return GL_LESS;
-        case raster::DepthFunc::Equal: return GL_EQUAL;
-        case raster::DepthFunc::LEqual: return GL_LEQUAL;
-        case raster::DepthFunc::Greater: return GL_GREATER;
-        case raster::DepthFunc::NotEqual: return GL_NOTEQUAL;
-        case raster::DepthFunc::GEqual: return GL_GEQUAL;
-        case raster::DepthFunc::Always: return GL_ALWAYS;
-    }
-    return GL_LESS;
-}
-
-}  // namespace
 
 raster::Result<std::unique_ptr<OsmesaDevice>> OsmesaDevice::create(int width, int height, raster::DepthFormat format) {
     std::unique_ptr<OsmesaDevice> d(new OsmesaDevice());
@@ -64,204 +32,47 @@ raster::Result<std::unique_ptr<OsmesaDevice>> OsmesaDevice::create(int width, in
     g.window.assign(4 * 4 * 4, 0);
     if (!OSMesaMakeCurrent(g.ctx, g.window.data(), GL_UNSIGNED_BYTE, 4, 4))
         return raster::Error{"OSMesaMakeCurrent failed"};
-
-    std::string log;
-    const char* vs = "#version 330 core\nlayout(location = 0) in vec4 p;\nvoid main() { gl_Position = p; }\n";
-    const char* fs = "#version 330 core\nvoid main() {}\n";
-    GLuint v = compile(GL_VERTEX_SHADER, vs, log);
-    GLuint f = compile(GL_FRAGMENT_SHADER, fs, log);
-    if (!log.empty()) return raster::Error{"shader compile failed: " + log};
-    g.program = glCreateProgram();
-    glAttachShader(g.program, v);
-    glAttachShader(g.program, f);
-    glLinkProgram(g.program);
-    GLint linked = 0;
-    glGetProgramiv(g.program, GL_LINK_STATUS, &linked);
-    if (!linked) return raster::Error{"program link failed"};
-    glUseProgram(g.program);
-
-    glGenVertexArrays(1, &g.vao);
-    glBindVertexArray(g.vao);
-    glGenBuffers(1, &g.vbo);
-    glGenBuffers(1, &g.ibo);
-    glBindBuffer(GL_ARRAY_BUFFER, g.vbo);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.ibo);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 4, GL_FLOAT, GL_FALSE, 16, nullptr);
-
-    const GLenum internal = format == raster::DepthFormat::D16   ? GL_DEPTH_COMPONENT16
-                            : format == raster::DepthFormat::D24 ? GL_DEPTH_COMPONENT24
-                                                                 : GL_DEPTH_COMPONENT32F;
-    glGenRenderbuffers(1, &g.depth_rb);
-    glBindRenderbuffer(GL_RENDERBUFFER, g.depth_rb);
-    glRenderbufferStorage(GL_RENDERBUFFER, internal, width, height);
-    glGenFramebuffers(1, &g.fbo);
-    glBindFramebuffer(GL_FRAMEBUFFER, g.fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, g.depth_rb);
-    glDrawBuffer(GL_NONE);
-    glReadBuffer(GL_NONE);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-        return raster::Error{"depth-only FBO is incomplete"};
-    GLint bits = 0;
-    glGetFramebufferAttachmentParameteriv(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_DEPTH_SIZE,
-                                          &bits);
-    const int want = format == raster::DepthFormat::D16 ? 16 : format == raster::DepthFormat::D24 ? 24 : 32;
-    if (bits != want) return raster::Error{"depth attachment has " + std::to_string(bits) + " bits, wanted " +
-                                           std::to_string(want)};
-    glEnable(GL_DEPTH_TEST);
-    glDisable(GL_MULTISAMPLE);
-    glPixelStorei(GL_PACK_ALIGNMENT, 1);
-    if (glGetError() != GL_NO_ERROR) return raster::Error{"GL error during setup"};
-    d->clear(1.0);
+    // libOSMesa does not export glGetQueryObjectui64v; its entry point is reachable this way.
+    auto get_query_u64 = reinterpret_cast<GlBatchRunner::GetQueryU64>(OSMesaGetProcAddress("glGetQueryObjectui64v"));
+    auto gl = GlBatchRunner::create(width, height, format, get_query_u64);
+    if (!gl.ok()) return gl.error();
+    g.gl = std::move(gl.value());
     return d;
 }
 
 OsmesaDevice::~OsmesaDevice() {
     if (impl_ && impl_->ctx) {
-        OSMesaMakeCurrent(impl_->ctx, impl_->window.data(), GL_UNSIGNED_BYTE, 4, 4);
-        glDeleteFramebuffers(1, &impl_->fbo);
-        glDeleteRenderbuffers(1, &impl_->depth_rb);
-        glDeleteBuffers(1, &impl_->vbo);
-        glDeleteBuffers(1, &impl_->ibo);
-        glDeleteVertexArrays(1, &impl_->vao);
-        glDeleteProgram(impl_->program);
+        impl_->make_current();
+        if (impl_->gl) impl_->gl->destroy();
         OSMesaDestroyContext(impl_->ctx);
     }
 }
 
 void OsmesaDevice::clear(double depth) {
-    OSMesaMakeCurrent(impl_->ctx, impl_->window.data(), GL_UNSIGNED_BYTE, 4, 4);
-    glBindFramebuffer(GL_FRAMEBUFFER, impl_->fbo);
-    glDepthMask(GL_TRUE);
-    glClearDepth(depth);
-    glClear(GL_DEPTH_BUFFER_BIT);
+    impl_->make_current();
+    impl_->gl->clear(depth);
 }
 
 raster::Result<raster::QueryResults> OsmesaDevice::run(const raster::CommandBatch& batch) {
-    Impl& g = *impl_;
     if (batch.rules() != raster::RasterRules::GlLlvmpipe)
         return raster::Error{"osmesa device: the batch is recorded for the Vulkan rules, not GL's"};
-    OSMesaMakeCurrent(g.ctx, g.window.data(), GL_UNSIGNED_BYTE, 4, 4);
-    glBindFramebuffer(GL_FRAMEBUFFER, g.fbo);
-    // One vertex and one index buffer for the whole batch; each draw uses a base vertex. Draws over
-    // the same vertex span (CULLIDE's sub-object draws all index their object's vertices) share one
-    // copy: copying the span per draw made batches of a large object gigabytes (GL_OUT_OF_MEMORY).
-    std::vector<raster::Float4> verts;
-    std::vector<std::uint32_t> idx;
-    struct Range {
-        std::size_t first_index, count, base_vertex;
-    };
-    std::vector<Range> ranges;
-    std::map<std::pair<const raster::Float4*, std::size_t>, std::size_t> span_base;
-    for (const auto& c : batch.commands()) {
-        if (c.kind != raster::Command::Kind::Draw) continue;
-        const auto key = std::make_pair(c.mesh.vertices.data(), c.mesh.vertices.size());
-        auto [it, fresh] = span_base.try_emplace(key, verts.size());
-        if (fresh) verts.insert(verts.end(), c.mesh.vertices.begin(), c.mesh.vertices.end());
-        ranges.push_back({idx.size(), c.mesh.indices.size(), it->second});
-        idx.insert(idx.end(), c.mesh.indices.begin(), c.mesh.indices.end());
-    }
-    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(verts.size() * sizeof(raster::Float4)), verts.data(),
-                 GL_STREAM_DRAW);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(idx.size() * 4), idx.data(), GL_STREAM_DRAW);
-
-    // libOSMesa does not export glGetQueryObjectui64v; its entry point is reachable this way.
-    using GetQueryU64 = void (*)(GLuint, GLenum, GLuint64*);
-    static const auto get_query_u64 =
-        reinterpret_cast<GetQueryU64>(OSMesaGetProcAddress("glGetQueryObjectui64v"));
-    if (get_query_u64 == nullptr) return raster::Error{"glGetQueryObjectui64v is not available"};
-    const auto& kinds = batch.query_kinds();
-    std::vector<GLuint> ids(kinds.size());
-    if (!ids.empty()) glGenQueries(static_cast<GLsizei>(ids.size()), ids.data());
-    GLenum active_target = 0;
-    std::size_t draw = 0;
-    int queries_since_flush = 0;
-    std::size_t triangles_since_flush = 0;
-    // See bounded_scenes in the header: a flush before a query begins, whenever the scene llvmpipe
-    // is filling may be large, so that binning a query's begin and end never meets a full scene.
-    // Only between queries: a flush inside a query would take the path under suspicion.
-    auto bound_scene = [&] {
-        if (!bounded_scenes_) return;
-        if (queries_since_flush < kQueriesPerFlush && triangles_since_flush < kTrianglesPerFlush) return;
-        glFlush();
-        queries_since_flush = 0;
-        triangles_since_flush = 0;
-    };
-    for (const auto& c : batch.commands()) {
-        switch (c.kind) {
-            case raster::Command::Kind::BeginQuery:
-                bound_scene();
-                ++queries_since_flush;
-                active_target = kinds[c.query] == raster::QueryKind::SamplesPassed ? GL_SAMPLES_PASSED
-                                                                                 : GL_ANY_SAMPLES_PASSED;
-                glBeginQuery(active_target, ids[c.query]);
-                break;
-            case raster::Command::Kind::EndQuery:
-                glEndQuery(active_target);
-                break;
-            case raster::Command::Kind::Draw: {
-                const raster::DrawState& s = c.state;
-                glDepthFunc(gl_func(s.depth_func));
-                glDepthMask(s.depth_write ? GL_TRUE : GL_FALSE);
-                if (s.cull_face == raster::CullFace::None) {
-                    glDisable(GL_CULL_FACE);
-                } else {
-                    glEnable(GL_CULL_FACE);
-                    glCullFace(s.cull_face == raster::CullFace::Front ? GL_FRONT : GL_BACK);
-                }
-                glFrontFace(s.front_face == raster::FrontFace::CCW ? GL_CCW : GL_CW);
-                const raster::Viewport vp = s.viewport ? *s.viewport : raster::Viewport{0, 0, width_, height_};
-                glViewport(vp.x, vp.y, vp.width, vp.height);
-                const Range& r = ranges[draw++];
-                triangles_since_flush += r.count / 3;
-                if (r.count > 0)
-                    glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(r.count), GL_UNSIGNED_INT,
-                                             reinterpret_cast<const void*>(r.first_index * 4),
-                                             static_cast<GLint>(r.base_vertex));
-                break;
-            }
-        }
-    }
-    raster::QueryResults out(kinds.size(), 0);
-    for (std::size_t q = 0; q < ids.size(); ++q) {
-        GLuint64 v = 0;
-        get_query_u64(ids[q], GL_QUERY_RESULT, &v);
-        out[q] = v;
-    }
-    if (!ids.empty()) glDeleteQueries(static_cast<GLsizei>(ids.size()), ids.data());
-    if (GLenum e = glGetError(); e != GL_NO_ERROR) return raster::Error{"GL error " + std::to_string(e) + " in run"};
-    return out;
+    impl_->make_current();
+    return impl_->gl->run(batch, bounded_scenes_);
 }
 
 std::vector<std::uint32_t> OsmesaDevice::read_depth() {
-    OSMesaMakeCurrent(impl_->ctx, impl_->window.data(), GL_UNSIGNED_BYTE, 4, 4);
-    glBindFramebuffer(GL_FRAMEBUFFER, impl_->fbo);
-    glFinish();
-    const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
-    std::vector<std::uint32_t> out(n);
-    if (format_ == raster::DepthFormat::D32F) {
-        glReadPixels(0, 0, width_, height_, GL_DEPTH_COMPONENT, GL_FLOAT, out.data());
-    } else if (format_ == raster::DepthFormat::D16) {
-        std::vector<std::uint16_t> s(n);
-        glReadPixels(0, 0, width_, height_, GL_DEPTH_COMPONENT, GL_UNSIGNED_SHORT, s.data());
-        for (std::size_t i = 0; i < n; ++i) out[i] = s[i];
-    } else {
-        // GL_UNSIGNED_INT scales the 24-bit value to 32 bits; its top 24 bits are the stored value.
-        glReadPixels(0, 0, width_, height_, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, out.data());
-        for (auto& v : out) v >>= 8;
-    }
-    return out;
+    impl_->make_current();
+    return impl_->gl->read_depth();
 }
 
 void OsmesaDevice::finish() {
-    OSMesaMakeCurrent(impl_->ctx, impl_->window.data(), GL_UNSIGNED_BYTE, 4, 4);
-    glFinish();
+    impl_->make_current();
+    impl_->gl->finish();
 }
 
 std::string OsmesaDevice::renderer() const {
-    OSMesaMakeCurrent(impl_->ctx, impl_->window.data(), GL_UNSIGNED_BYTE, 4, 4);
-    const auto* s = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    return s ? s : "";
+    impl_->make_current();
+    return impl_->gl->renderer();
 }
 
 }  // namespace cullide_oracle

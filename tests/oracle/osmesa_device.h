@@ -1,7 +1,8 @@
 // osmesa_device.h: the real-GL oracle of the raster tests and benchmarks (Mesa llvmpipe through
 // OSMesa). It runs a raster::CommandBatch through OpenGL 4.5 core with the same clip-space floats
 // (a pass-through vertex shader, so no GPU-side matrix multiply) into an FBO whose only attachment
-// is a depth renderbuffer of the requested format, and reads results back with exact bits.
+// is a depth renderbuffer of the requested format, and reads results back with exact bits. The GL
+// work is gl_batch_runner.h's, shared with the EGL device (egl_device.h).
 // Test and benchmark code only: never linked into a library. No OSMesa header leaks from here.
 #pragma once
 
@@ -29,15 +30,13 @@ class OsmesaDevice {
     // Fails unless the batch is recorded for RasterRules::GlLlvmpipe. Issues every command (all queries first, results read at the end, so GL can batch), then
     // returns the query results indexed like the batch's queries (0/1 for any-samples queries).
     // With bounded scenes (the default) a glFlush goes before a glBeginQuery once
-    // kQueriesPerFlush queries or kTrianglesPerFlush triangles were issued since the last one:
+    // GlBatchRunner::kQueriesPerFlush queries or kTrianglesPerFlush triangles were issued since the last one:
     // llvmpipe (Mesa 22.3) over-counts a query now and then in one long stream of queries, most
     // likely when its binned scene fills up while a query's begin/end is binned
     // (docs/raster-known-differences.md, "Whole batches"); tests/oracle/llvmpipe_scene_test.cpp
     // shows it with bounded scenes off. glFlush changes no result under the GL rules, so this only
     // keeps llvmpipe off its faulty path.
     [[nodiscard]] raster::Result<raster::QueryResults> run(const raster::CommandBatch& batch);
-    static constexpr int kQueriesPerFlush = 64;
-    static constexpr std::size_t kTrianglesPerFlush = 16384;
     void set_bounded_scenes(bool on) { bounded_scenes_ = on; }
     [[nodiscard]] bool bounded_scenes() const { return bounded_scenes_; }
     // The depth buffer, row 0 at the bottom, in raster::DepthTarget's encoding.

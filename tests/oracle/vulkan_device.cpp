@@ -6,6 +6,7 @@
 #include <vulkan/vulkan.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <map>
 #include <string>
@@ -184,7 +185,8 @@ void VulkanDevice::Impl::full_barrier() {
                          nullptr, 0, nullptr);
 }
 
-raster::Result<std::unique_ptr<VulkanDevice>> VulkanDevice::create(int width, int height, raster::DepthFormat format) {
+raster::Result<std::unique_ptr<VulkanDevice>> VulkanDevice::create(int width, int height, raster::DepthFormat format,
+                                                                        const std::string& device) {
     if (width < 1 || height < 1 || width > raster::kMaxTargetSize || height > raster::kMaxTargetSize)
         return raster::Error{"vulkan device: bad target size"};
     std::unique_ptr<VulkanDevice> d(new VulkanDevice());
@@ -205,21 +207,37 @@ raster::Result<std::unique_ptr<VulkanDevice>> VulkanDevice::create(int width, in
     vkEnumeratePhysicalDevices(g.instance, &n, nullptr);
     std::vector<VkPhysicalDevice> pds(n);
     vkEnumeratePhysicalDevices(g.instance, &n, pds.data());
+    auto lower = [](std::string t) {
+        for (char& c : t) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        return t;
+    };
+    const std::string wanted = lower(device);
+    std::string seen;
     for (VkPhysicalDevice pd : pds) {
         auto drv = vk_struct<VkPhysicalDeviceDriverProperties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES);
         auto props = vk_struct<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
         props.pNext = &drv;
         vkGetPhysicalDeviceProperties2(pd, &props);
-        if (drv.driverID == VK_DRIVER_ID_MESA_LLVMPIPE && props.properties.apiVersion >= VK_API_VERSION_1_3) {
+        const std::string name = props.properties.deviceName;
+        seen += (seen.empty() ? "" : "; ") + name;
+        const bool match = wanted.empty() ? drv.driverID == VK_DRIVER_ID_MESA_LLVMPIPE
+                                          : lower(name).find(wanted) != std::string::npos;
+        if (match && props.properties.apiVersion >= VK_API_VERSION_1_3) {
             g.physical = pd;
-            g.name = props.properties.deviceName;
+            g.name = name;
             g.name.append(", ");
+            g.name.append(drv.driverName);
+            g.name.append(" ");
             g.name.append(drv.driverInfo);
             break;
         }
     }
-    if (g.physical == VK_NULL_HANDLE)
-        return raster::Error{"vulkan device: no Vulkan 1.3 lavapipe device (install mesa-vulkan-drivers)"};
+    if (g.physical == VK_NULL_HANDLE) {
+        if (wanted.empty())
+            return raster::Error{"vulkan device: no Vulkan 1.3 lavapipe device (install mesa-vulkan-drivers)"};
+        return raster::Error{"vulkan device: no Vulkan 1.3 device named like '" + device + "' (there are: " +
+                             (seen.empty() ? std::string("none") : seen) + ")"};
+    }
     VkPhysicalDeviceFeatures features{};
     vkGetPhysicalDeviceFeatures(g.physical, &features);
     if (!features.occlusionQueryPrecise) return raster::Error{"vulkan device: no occlusionQueryPrecise"};

@@ -22,8 +22,12 @@ class VulkanDevice {
     // D24_UNORM_S8_UINT where X8 cannot be a depth attachment), D32F -> VK_FORMAT_D32_SFLOAT.
     // Fails with a message when there is no Vulkan 1.3 lavapipe device, no precise occlusion
     // queries, or the format cannot be a depth attachment. Cleared to depth 1.0.
+    // `device`, when not empty, picks instead the first Vulkan 1.3 physical device whose name contains
+    // it (case-insensitive), for example "NVIDIA": the real-driver runs of tests/raster/driver_report.cpp.
+    // The error then lists the devices there are.
     [[nodiscard]] static raster::Result<std::unique_ptr<VulkanDevice>> create(int width, int height,
-                                                                           raster::DepthFormat format);
+                                                                           raster::DepthFormat format,
+                                                                           const std::string& device = {});
     ~VulkanDevice();
     VulkanDevice(const VulkanDevice&) = delete;
     VulkanDevice& operator=(const VulkanDevice&) = delete;
