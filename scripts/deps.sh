@@ -14,9 +14,9 @@ set -euo pipefail
 want=(cmake ninja-build g++ pkg-config libtbb-dev)
 case "${1:-run}" in
   run) ;;
-  test) want+=(libeigen3-dev doctest-dev libgmp-dev libosmesa6-dev libegl-dev libopengl-dev libegl-mesa0 libvulkan-dev glslang-tools mesa-vulkan-drivers libembree-dev libbenchmark-dev) ;;
-  fuzz) want+=(libeigen3-dev doctest-dev libgmp-dev libosmesa6-dev libegl-dev libopengl-dev libegl-mesa0 libvulkan-dev glslang-tools mesa-vulkan-drivers libembree-dev libbenchmark-dev clang libclang-rt-14-dev) ;;
-  bench) want+=(libeigen3-dev doctest-dev libgmp-dev libosmesa6-dev libegl-dev libopengl-dev libegl-mesa0 libvulkan-dev glslang-tools mesa-vulkan-drivers libembree-dev libbenchmark-dev libfcl-dev libbullet-dev
+  test) want+=(libeigen3-dev doctest-dev libgmp-dev libosmesa6-dev libegl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libvulkan-dev glslang-tools mesa-vulkan-drivers libembree-dev libbenchmark-dev) ;;
+  fuzz) want+=(libeigen3-dev doctest-dev libgmp-dev libosmesa6-dev libegl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libvulkan-dev glslang-tools mesa-vulkan-drivers libembree-dev libbenchmark-dev clang libclang-rt-14-dev) ;;
+  bench) want+=(libeigen3-dev doctest-dev libgmp-dev libosmesa6-dev libegl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libvulkan-dev glslang-tools mesa-vulkan-drivers libembree-dev libbenchmark-dev libfcl-dev libbullet-dev
                libcgal-dev python3-matplotlib) ;;
   *) echo "usage: $0 run|test|fuzz|bench" >&2; exit 2 ;;
 esac
