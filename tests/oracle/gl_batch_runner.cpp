@@ -3,11 +3,11 @@
 #define GL_GLEXT_PROTOTYPES 1
 #include "gl_batch_runner.h"
 
+#include "batch_geometry.h"
+
 #include <GL/gl.h>
 #include <GL/glext.h>
 
-#include <map>
-#include <utility>
 
 namespace cullide_oracle {
 
@@ -123,24 +123,10 @@ void GlBatchRunner::clear(double depth) {
 
 raster::Result<raster::QueryResults> GlBatchRunner::run(const raster::CommandBatch& batch, bool bounded_scenes) {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
-    // One vertex and one index buffer for the whole batch; each draw uses a base vertex. Draws over
-    // the same vertex span (CULLIDE's sub-object draws all index their object's vertices) share one
-    // copy: copying the span per draw made batches of a large object gigabytes (GL_OUT_OF_MEMORY).
-    std::vector<raster::Float4> verts;
-    std::vector<std::uint32_t> idx;
-    struct Range {
-        std::size_t first_index, count, base_vertex;
-    };
-    std::vector<Range> ranges;
-    std::map<std::pair<const raster::Float4*, std::size_t>, std::size_t> span_base;
-    for (const auto& c : batch.commands()) {
-        if (c.kind != raster::Command::Kind::Draw) continue;
-        const auto key = std::make_pair(c.mesh.vertices.data(), c.mesh.vertices.size());
-        auto [it, fresh] = span_base.try_emplace(key, verts.size());
-        if (fresh) verts.insert(verts.end(), c.mesh.vertices.begin(), c.mesh.vertices.end());
-        ranges.push_back({idx.size(), c.mesh.indices.size(), it->second});
-        idx.insert(idx.end(), c.mesh.indices.begin(), c.mesh.indices.end());
-    }
+    const BatchGeometry geometry(batch);
+    const auto& verts = geometry.vertices;
+    const auto& idx = geometry.indices;
+    const auto& ranges = geometry.draws;
     glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(verts.size() * sizeof(raster::Float4)), verts.data(),
                  GL_STREAM_DRAW);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, static_cast<GLsizeiptr>(idx.size() * 4), idx.data(), GL_STREAM_DRAW);
@@ -187,7 +173,7 @@ raster::Result<raster::QueryResults> GlBatchRunner::run(const raster::CommandBat
                 glFrontFace(s.front_face == raster::FrontFace::CCW ? GL_CCW : GL_CW);
                 const raster::Viewport vp = s.viewport ? *s.viewport : raster::Viewport{0, 0, width_, height_};
                 glViewport(vp.x, vp.y, vp.width, vp.height);
-                const Range& r = ranges[draw++];
+                const BatchGeometry::Range& r = ranges[draw++];
                 triangles_since_flush += r.count / 3;
                 if (r.count > 0)
                     glDrawElementsBaseVertex(GL_TRIANGLES, static_cast<GLsizei>(r.count), GL_UNSIGNED_INT,

@@ -3,12 +3,13 @@
 // every submission is followed by a fence wait, and full memory barriers separate the steps.
 #include "vulkan_device.h"
 
+#include "batch_geometry.h"
+
 #include <vulkan/vulkan.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cstring>
-#include <map>
 #include <string>
 #include <utility>
 
@@ -463,25 +464,13 @@ raster::Result<raster::QueryResults> VulkanDevice::run(const raster::CommandBatc
     Impl& g = *impl_;
     if (batch.rules() != raster::RasterRules::Vulkan)
         return raster::Error{"vulkan device: the batch is recorded for the GL rules (clip z in [-w, w])"};
-    // One vertex and one index buffer for the whole batch, each draw at its base vertex; draws over
-    // the same vertex span share one copy (as the OSMesa device does).
-    std::vector<raster::Float4> verts;
-    std::vector<std::uint32_t> idx;
-    struct Range {
-        std::size_t first_index, count, base_vertex;
-    };
-    std::vector<Range> ranges;
-    std::map<std::pair<const raster::Float4*, std::size_t>, std::size_t> span_base;
-    for (const auto& c : batch.commands()) {
-        if (c.kind != raster::Command::Kind::Draw) continue;
-        if (c.double_input || c.state.mode != raster::RasterMode::GLExact)
+    for (const auto& c : batch.commands())
+        if (c.kind == raster::Command::Kind::Draw && (c.double_input || c.state.mode != raster::RasterMode::GLExact))
             return raster::Error{"vulkan device: exact-bounds draws and double input have no Vulkan counterpart"};
-        const auto key = std::make_pair(c.mesh.vertices.data(), c.mesh.vertices.size());
-        auto [it, fresh] = span_base.try_emplace(key, verts.size());
-        if (fresh) verts.insert(verts.end(), c.mesh.vertices.begin(), c.mesh.vertices.end());
-        ranges.push_back({idx.size(), c.mesh.indices.size(), it->second});
-        idx.insert(idx.end(), c.mesh.indices.begin(), c.mesh.indices.end());
-    }
+    const BatchGeometry geometry(batch);  // one copy of each vertex span (batch_geometry.h)
+    const auto& verts = geometry.vertices;
+    const auto& idx = geometry.indices;
+    const auto& ranges = geometry.draws;
     if (raster::Status s = g.make_buffer(g.vertices, verts.size() * sizeof(raster::Float4),
                                          VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
         !s)
@@ -537,7 +526,7 @@ raster::Result<raster::QueryResults> VulkanDevice::run(const raster::CommandBatc
                                    static_cast<float>(vp.width), static_cast<float>(vp.height),
                                    0.0f,                         1.0f};
                 vkCmdSetViewport(g.cmd, 0, 1, &v);
-                const Range& r = ranges[draw++];
+                const BatchGeometry::Range& r = ranges[draw++];
                 if (r.count > 0)
                     vkCmdDrawIndexed(g.cmd, static_cast<std::uint32_t>(r.count), 1,
                                      static_cast<std::uint32_t>(r.first_index), static_cast<std::int32_t>(r.base_vertex),
