@@ -320,9 +320,12 @@ void bin(const SetupDraws& setup, std::size_t d0, std::size_t d1, const Tiles& t
         const auto add = [&](std::size_t d, std::size_t t, int tx, int ty) {
             bins[tiles.index(tx, ty)].push_back({static_cast<std::uint32_t>(d), static_cast<std::uint32_t>(t)});
         };
+        // The tile of a pixel coordinate. Setup's boxes lie inside the target (>= 0), so an unsigned
+        // shift is the division, without the signed one's fix-up on every triangle.
+        const auto tile_of = [](int p) { return static_cast<int>(static_cast<unsigned>(p) / unsigned{kTileSize}); };
         const auto bin_box = [&](std::size_t d, std::size_t t, int bx0, int by0, int bx1, int by1) {
-            for (int ty = std::max(by0 / kTileSize, band_ty0); ty <= std::min(by1 / kTileSize, band_ty1); ++ty)
-                for (int tx = bx0 / kTileSize; tx <= bx1 / kTileSize; ++tx) add(d, t, tx, ty);
+            for (int ty = std::max(tile_of(by0), band_ty0); ty <= std::min(tile_of(by1), band_ty1); ++ty)
+                for (int tx = tile_of(bx0); tx <= tile_of(bx1); ++tx) add(d, t, tx, ty);
         };
         // Draw d's GL-exact triangles into this band's tiles; with Cull, without those of the
         // facing the draw culls (share_setup left its culling to binning: CullFace::Front drops
@@ -334,10 +337,12 @@ void bin(const SetupDraws& setup, std::size_t d0, std::size_t d1, const Tiles& t
                 if constexpr (Cull) {
                     if (tri.front == drop_front) continue;
                 }
-                const int ty0 = std::max(tri.y0 / kTileSize, band_ty0), ty1 = std::min(tri.y1 / kTileSize, band_ty1);
+                const int tile_y0 = tile_of(tri.y0), tile_y1 = tile_of(tri.y1);
+                const int ty0 = std::max(tile_y0, band_ty0), ty1 = std::min(tile_y1, band_ty1);
                 if (ty0 > ty1) continue;
-                if (tri.y0 / kTileSize == tri.y1 / kTileSize && tri.x0 / kTileSize == tri.x1 / kTileSize) {
-                    bin_box(d, t, tri.x0, tri.y0, tri.x1, tri.y1);
+                const int tx0 = tile_of(tri.x0), tx1 = tile_of(tri.x1);
+                if (tile_y0 == tile_y1 && tx0 == tx1) {  // one tile (most triangles at CULLIDE's sizes)
+                    add(d, t, tx0, tile_y0);
                     continue;
                 }
                 // GL-exact triangles over several tiles: tile-level trivial reject (no centre of the
@@ -346,7 +351,7 @@ void bin(const SetupDraws& setup, std::size_t d0, std::size_t d1, const Tiles& t
                 detail::RectReject reject(tri);
                 for (int ty = ty0; ty <= ty1; ++ty) {
                     reject.set_rows(std::max(tri.y0, ty * kTileSize), std::min(tri.y1, ty * kTileSize + kTileSize - 1));
-                    for (int tx = tri.x0 / kTileSize; tx <= tri.x1 / kTileSize; ++tx) {
+                    for (int tx = tx0; tx <= tx1; ++tx) {
                         const int rx0 = std::max(tri.x0, tx * kTileSize);
                         const int rx1 = std::min(tri.x1, tx * kTileSize + kTileSize - 1);
                         if (!reject.outside(rx0, rx1)) add(d, t, tx, ty);
