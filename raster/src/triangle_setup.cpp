@@ -161,7 +161,6 @@ void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const 
         std::swap(y[a], y[a + 1]);
     }
 
-    SetupTri t{};
     // Bounding box (inclusive), llvmpipe's rounding for its fill convention.
     const int adj = rules.bottom_edge_rule ? 1 : 0;
     const int64_t minx = std::min({x[0], x[1], x[2]}), maxx = std::max({x[0], x[1], x[2]});
@@ -175,6 +174,8 @@ void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const 
     bx1 = std::min<int64_t>(bx1, p.target_width - 1);
     by1 = std::min<int64_t>(by1, p.target_height - 1);
     if (bx0 > bx1 || by0 > by1) return;
+    // Built in place (no return below): a copy of the ~100-byte record per triangle cost more.
+    SetupTri& t = out.emplace_back();
     t.x0 = static_cast<int>(bx0);
     t.y0 = static_cast<int>(by0);
     t.x1 = static_cast<int>(bx1);
@@ -228,7 +229,6 @@ void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const 
         const int64_t span_x = maxx - minx, span_y = maxy - miny;
         t.fits32 = span_y * (span_x + 2048) + span_x * (span_y + 256) + 1 < (int64_t{1} << 31);
     }
-    out.push_back(t);
 }
 
 }  // namespace
