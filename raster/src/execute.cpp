@@ -284,8 +284,7 @@ void front_end(const DepthTarget& target, const Draws& draws, int threads, Setup
         const auto& vtx = c.mesh.vertices;
         auto& list = pieces[j].k0 == 0 ? out.tris[d] : piece_out[j];
         list.reserve(list.size() + (pieces[j].k1 - pieces[j].k0) / 3);  // one SetupTri per unclipped triangle
-        for (std::size_t k = pieces[j].k0; k + 2 < pieces[j].k1; k += 3)
-            detail::setup_triangle(p, vtx[idx[k]], vtx[idx[k + 1]], vtx[idx[k + 2]], draws.index[d], list);
+        detail::setup_range(p, vtx, idx.subspan(pieces[j].k0, pieces[j].k1 - pieces[j].k0), draws.index[d], list);
     });
     for (std::size_t j = 0; j < pieces.size(); ++j)
         if (pieces[j].k0 != 0)

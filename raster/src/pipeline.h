@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "depth_dispatch.h"
@@ -68,6 +69,21 @@ inline void setup_triangle(const FrontEndParams& params, const Float4& a, const 
         setup_triangle_for<RasterRules::Vulkan>(params, a, b, c, draw, out);
     else
         setup_triangle_for<RasterRules::GlLlvmpipe>(params, a, b, c, draw, out);
+}
+
+// setup_triangle for the triangles of `indices` (whole triangles; a remainder is ignored) over
+// `vertices`, appending in order. When they hold at least as many indices as the list has vertices
+// (a whole object's draw), each vertex goes through the clip test and the viewport once instead of
+// once per triangle corner: the same operations on the same values, so the same SetupTri.
+template <RasterRules Rules>
+void setup_range_for(const FrontEndParams& params, std::span<const Float4> vertices,
+                     std::span<const std::uint32_t> indices, std::uint32_t draw, std::vector<SetupTri>& out);
+inline void setup_range(const FrontEndParams& params, std::span<const Float4> vertices,
+                        std::span<const std::uint32_t> indices, std::uint32_t draw, std::vector<SetupTri>& out) {
+    if (params.rules == RasterRules::Vulkan)
+        setup_range_for<RasterRules::Vulkan>(params, vertices, indices, draw, out);
+    else
+        setup_range_for<RasterRules::GlLlvmpipe>(params, vertices, indices, draw, out);
 }
 
 // Rasterizes `tri` over `rect` (inside the target and the triangle's box) into `depth` with the

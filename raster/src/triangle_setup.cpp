@@ -231,20 +231,16 @@ void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const 
     }
 }
 
-}  // namespace
-
+// The rest of setup_triangle_for, from vertices already through the clip test (masks m0..m2) and the
+// viewport: whole-triangle rejection, then setup, or clipping and the setup of the fan.
 template <RasterRules Rules>
-void setup_triangle_for(const FrontEndParams& params, const Float4& a, const Float4& b, const Float4& c,
-                        std::uint32_t draw, std::vector<SetupTri>& out) {
+void setup_transformed(const FrontEndParams& params, const ViewportXform& xf, const ClipVertex* v0,
+                       const ClipVertex* v1, const ClipVertex* v2, unsigned m0, unsigned m1, unsigned m2,
+                       std::uint32_t draw, std::vector<SetupTri>& out) {
     constexpr RuleSet rules = rule_set(Rules);
-    const ViewportXform xf = make_xform(rules, params.viewport);
-    ClipVertex in[3] = {{{a.x, a.y, a.z, a.w}, {}}, {{b.x, b.y, b.z, b.w}, {}}, {{c.x, c.y, c.z, c.w}, {}}};
-    unsigned m[3];
-    for (int i = 0; i < 3; ++i) m[i] = clip_mask<rules.half_z>(in[i].clip);
-    if ((m[0] & m[1] & m[2]) != 0) return;  // wholly outside one plane
-    for (auto& v : in) shader_viewport(xf, v);
-    if ((m[0] | m[1] | m[2]) == 0) {
-        setup_window_triangle<Rules>(params, &in[0], &in[1], &in[2], draw, out);
+    if ((m0 & m1 & m2) != 0) return;  // wholly outside one plane
+    if ((m0 | m1 | m2) == 0) {
+        setup_window_triangle<Rules>(params, v0, v1, v2, draw, out);
         return;
     }
 
@@ -253,12 +249,12 @@ void setup_triangle_for(const FrontEndParams& params, const Float4& a, const Flo
     constexpr int kMaxVerts = 3 + 6 + 1;
     ClipVertex pool[2 * kMaxVerts];
     int pool_used = 0;
-    const ClipVertex* list_a[kMaxVerts + 1] = {&in[0], &in[1], &in[2]};
+    const ClipVertex* list_a[kMaxVerts + 1] = {v0, v1, v2};
     const ClipVertex* list_b[kMaxVerts + 1] = {};
     const ClipVertex** inlist = list_a;
     const ClipVertex** outlist = list_b;
     int n = 3;
-    unsigned mask = m[0] | m[1] | m[2];
+    unsigned mask = m0 | m1 | m2;
     while (mask != 0 && n >= 3) {
         const int plane = std::countr_zero(mask);
         mask &= ~(1u << plane);
@@ -313,6 +309,61 @@ void setup_triangle_for(const FrontEndParams& params, const Float4& a, const Flo
     }
 }
 
+}  // namespace
+
+template <RasterRules Rules>
+void setup_triangle_for(const FrontEndParams& params, const Float4& a, const Float4& b, const Float4& c,
+                        std::uint32_t draw, std::vector<SetupTri>& out) {
+    constexpr RuleSet rules = rule_set(Rules);
+    const ViewportXform xf = make_xform(rules, params.viewport);
+    ClipVertex in[3] = {{{a.x, a.y, a.z, a.w}, {}}, {{b.x, b.y, b.z, b.w}, {}}, {{c.x, c.y, c.z, c.w}, {}}};
+    unsigned m[3];
+    for (int i = 0; i < 3; ++i) m[i] = clip_mask<rules.half_z>(in[i].clip);
+    if ((m[0] & m[1] & m[2]) != 0) return;  // wholly outside one plane
+    for (auto& v : in) shader_viewport(xf, v);
+    setup_transformed<Rules>(params, xf, &in[0], &in[1], &in[2], m[0], m[1], m[2], draw, out);
+}
+
+template <RasterRules Rules>
+void setup_range_for(const FrontEndParams& params, std::span<const Float4> vertices,
+                     std::span<const std::uint32_t> indices, std::uint32_t draw, std::vector<SetupTri>& out) {
+    constexpr RuleSet rules = rule_set(Rules);
+    const std::size_t n = indices.size() / 3 * 3;
+    if (n < vertices.size()) {  // a few triangles of a large list (a sub-object's draw): per corner
+        for (std::size_t k = 0; k < n; k += 3)
+            setup_triangle_for<Rules>(params, vertices[indices[k]], vertices[indices[k + 1]], vertices[indices[k + 2]],
+                                      draw, out);
+        return;
+    }
+    // Each vertex through the clip test and the viewport once. An unused vertex of the list may be
+    // anything (validation checks only the vertices that triangles use): its values are never read.
+    const ViewportXform xf = make_xform(rules, params.viewport);
+    thread_local std::vector<ClipVertex> cache;
+    thread_local std::vector<unsigned> masks;
+    cache.resize(vertices.size());
+    masks.resize(vertices.size());
+    for (std::size_t i = 0; i < vertices.size(); ++i) {
+        const Float4& p = vertices[i];
+        ClipVertex& v = cache[i];
+        v.clip[0] = p.x;
+        v.clip[1] = p.y;
+        v.clip[2] = p.z;
+        v.clip[3] = p.w;
+        masks[i] = clip_mask<rules.half_z>(v.clip);
+        shader_viewport(xf, v);
+    }
+    for (std::size_t k = 0; k < n; k += 3) {
+        const std::uint32_t a = indices[k], b = indices[k + 1], c = indices[k + 2];
+        setup_transformed<Rules>(params, xf, &cache[a], &cache[b], &cache[c], masks[a], masks[b], masks[c], draw, out);
+    }
+}
+
+template void setup_range_for<RasterRules::GlLlvmpipe>(const FrontEndParams&, std::span<const Float4>,
+                                                       std::span<const std::uint32_t>, std::uint32_t,
+                                                       std::vector<SetupTri>&);
+template void setup_range_for<RasterRules::Vulkan>(const FrontEndParams&, std::span<const Float4>,
+                                                   std::span<const std::uint32_t>, std::uint32_t,
+                                                   std::vector<SetupTri>&);
 template void setup_triangle_for<RasterRules::GlLlvmpipe>(const FrontEndParams&, const Float4&, const Float4&,
                                                           const Float4&, std::uint32_t, std::vector<SetupTri>&);
 template void setup_triangle_for<RasterRules::Vulkan>(const FrontEndParams&, const Float4&, const Float4&,
