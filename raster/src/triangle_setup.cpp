@@ -20,6 +20,13 @@ struct ClipVertex {
     float win[3];
 };
 
+// A vertex through the clip test (its mask) and the viewport, once for all its triangles
+// (setup_range_for).
+struct TransformedVertex {
+    ClipVertex v;
+    unsigned mask;
+};
+
 constexpr int kFixedOrder = 8;  // 16.8: 1/256 pixel
 constexpr float kFixedOne = 256.0f;
 
@@ -338,23 +345,21 @@ void setup_range_for(const FrontEndParams& params, std::span<const Float4> verti
     // Each vertex through the clip test and the viewport once. An unused vertex of the list may be
     // anything (validation checks only the vertices that triangles use): its values are never read.
     const ViewportXform xf = make_xform(rules, params.viewport);
-    thread_local std::vector<ClipVertex> cache;
-    thread_local std::vector<unsigned> masks;
+    thread_local std::vector<TransformedVertex> cache;
     cache.resize(vertices.size());
-    masks.resize(vertices.size());
     for (std::size_t i = 0; i < vertices.size(); ++i) {
         const Float4& p = vertices[i];
-        ClipVertex& v = cache[i];
-        v.clip[0] = p.x;
-        v.clip[1] = p.y;
-        v.clip[2] = p.z;
-        v.clip[3] = p.w;
-        masks[i] = clip_mask<rules.half_z>(v.clip);
-        shader_viewport(xf, v);
+        TransformedVertex& t = cache[i];
+        t.v.clip[0] = p.x;
+        t.v.clip[1] = p.y;
+        t.v.clip[2] = p.z;
+        t.v.clip[3] = p.w;
+        t.mask = clip_mask<rules.half_z>(t.v.clip);
+        shader_viewport(xf, t.v);
     }
     for (std::size_t k = 0; k < n; k += 3) {
-        const std::uint32_t a = indices[k], b = indices[k + 1], c = indices[k + 2];
-        setup_transformed<Rules>(params, xf, &cache[a], &cache[b], &cache[c], masks[a], masks[b], masks[c], draw, out);
+        const TransformedVertex &a = cache[indices[k]], &b = cache[indices[k + 1]], &c = cache[indices[k + 2]];
+        setup_transformed<Rules>(params, xf, &a.v, &b.v, &c.v, a.mask, b.mask, c.mask, draw, out);
     }
 }
 

@@ -19,6 +19,9 @@ struct EglDevice::Impl {
     std::unique_ptr<GlBatchRunner> gl;
     std::string renderer;
 
+    // Makes a current OpenGL 4.5 core context on `dpy` (display, context, surface and renderer set),
+    // or says why not; release() undoes what was made either way.
+    std::string open(EGLDisplay dpy);
     void make_current() const { eglMakeCurrent(display, surface, surface, context); }
     void release() {
         if (context == EGL_NO_CONTEXT) return;
@@ -49,42 +52,34 @@ bool has_extension(const char* list, const char* name) {
     return false;
 }
 
-// A current OpenGL 4.5 core context on `display` (context, surface and renderer set), or why not.
-struct Opened {
-    EGLDisplay display = EGL_NO_DISPLAY;
-    EGLContext context = EGL_NO_CONTEXT;
-    EGLSurface surface = EGL_NO_SURFACE;
-    std::string renderer;
-};
+}  // namespace
 
-std::string open_context(EGLDisplay display, Opened& g) {
+std::string EglDevice::Impl::open(EGLDisplay dpy) {
     EGLint major = 0, minor = 0;
-    if (!eglInitialize(display, &major, &minor)) return "eglInitialize failed";
+    if (!eglInitialize(dpy, &major, &minor)) return "eglInitialize failed";
     if (!eglBindAPI(EGL_OPENGL_API)) return "eglBindAPI(EGL_OPENGL_API) failed";
-    const bool surfaceless = has_extension(eglQueryString(display, EGL_EXTENSIONS), "EGL_KHR_surfaceless_context");
+    const bool surfaceless = has_extension(eglQueryString(dpy, EGL_EXTENSIONS), "EGL_KHR_surfaceless_context");
     const EGLint config_attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE,
                                      surfaceless ? 0 : EGL_PBUFFER_BIT, EGL_NONE};
     EGLConfig config = nullptr;
     EGLint configs = 0;
-    if (!eglChooseConfig(display, config_attribs, &config, 1, &configs) || configs < 1)
+    if (!eglChooseConfig(dpy, config_attribs, &config, 1, &configs) || configs < 1)
         return "no EGL config renders OpenGL";
     const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
                                       EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
-    g.display = display;
-    g.context = eglCreateContext(display, config, EGL_NO_CONTEXT, context_attribs);
-    if (g.context == EGL_NO_CONTEXT) return "eglCreateContext (OpenGL 4.5 core) failed";
+    display = dpy;
+    context = eglCreateContext(dpy, config, EGL_NO_CONTEXT, context_attribs);
+    if (context == EGL_NO_CONTEXT) return "eglCreateContext (OpenGL 4.5 core) failed";
     if (!surfaceless) {
         const EGLint pbuffer_attribs[] = {EGL_WIDTH, 4, EGL_HEIGHT, 4, EGL_NONE};
-        g.surface = eglCreatePbufferSurface(display, config, pbuffer_attribs);
-        if (g.surface == EGL_NO_SURFACE) return "eglCreatePbufferSurface failed";
+        surface = eglCreatePbufferSurface(dpy, config, pbuffer_attribs);
+        if (surface == EGL_NO_SURFACE) return "eglCreatePbufferSurface failed";
     }
-    if (!eglMakeCurrent(display, g.surface, g.surface, g.context)) return "eglMakeCurrent failed";
+    if (!eglMakeCurrent(dpy, surface, surface, context)) return "eglMakeCurrent failed";
     const auto* r = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    g.renderer = r ? r : "";
+    renderer = r ? r : "";
     return {};
 }
-
-}  // namespace
 
 raster::Result<std::unique_ptr<EglDevice>> EglDevice::create(int width, int height, raster::DepthFormat format,
                                                              const std::string& device) {
@@ -113,13 +108,8 @@ raster::Result<std::unique_ptr<EglDevice>> EglDevice::create(int width, int heig
     const std::string wanted = lower(device);
     std::string seen;
     for (EGLDisplay dpy : displays) {
-        Opened opened;
-        const std::string why = open_context(dpy, opened);
         auto impl = std::make_unique<Impl>();
-        impl->display = opened.display;
-        impl->context = opened.context;
-        impl->surface = opened.surface;
-        impl->renderer = opened.renderer;
+        const std::string why = impl->open(dpy);
         if (!why.empty()) {
             seen += (seen.empty() ? "" : "; ") + why;
             impl->release();

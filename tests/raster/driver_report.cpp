@@ -197,32 +197,28 @@ int main(int argc, char** argv) {
     double scene_scale = 0.05;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
-        auto value = [&](const char* name) -> const char* {
-            if (i + 1 >= argc) return nullptr;
-            (void)name;
-            return argv[++i];
-        };
+        auto value = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
         if (a == "--api") {
-            const char* v = value("--api");
+            const char* v = value();
             if (v == nullptr) return usage("--api needs gl or vulkan");
             api = v;
         } else if (a == "--device") {
-            const char* v = value("--device");
+            const char* v = value();
             if (v == nullptr) return usage("--device needs a name");
             device = v;
         } else if (a == "--scale") {
-            const char* v = value("--scale");
+            const char* v = value();
             char* end = nullptr;
             scale = v ? std::strtol(v, &end, 10) : 0;
             if (v == nullptr || *end != '\0' || scale < 1 || scale > 1000)
                 return usage("--scale needs an integer in 1..1000");
         } else if (a == "--seed") {
-            const char* v = value("--seed");
+            const char* v = value();
             char* end = nullptr;
             seed = v ? std::strtoull(v, &end, 10) : 0;
             if (v == nullptr || *end != '\0') return usage("--seed needs an unsigned integer");
         } else if (a == "--json") {
-            const char* v = value("--json");
+            const char* v = value();
             if (v == nullptr) return usage("--json needs a file");
             json = v;
         } else if (a == "--expect-identical") {
@@ -230,7 +226,7 @@ int main(int argc, char** argv) {
         } else if (a == "--frames") {
             frames = true;
         } else if (a == "--frame-resolutions") {
-            const char* v = value("--frame-resolutions");
+            const char* v = value();
             if (v == nullptr) return usage("--frame-resolutions needs a list like 64,200,1024");
             frame_resolutions.clear();
             std::string list = v;
@@ -245,7 +241,7 @@ int main(int argc, char** argv) {
                 at = comma + 1;
             }
         } else if (a == "--scene-scale") {
-            const char* v = value("--scene-scale");
+            const char* v = value();
             char* end = nullptr;
             scene_scale = v ? std::strtod(v, &end) : 0;
             if (v == nullptr || *end != '\0' || !(scene_scale > 0 && scene_scale <= 1))
