@@ -44,6 +44,9 @@ int tile_side(int width, int height) {
 constexpr int kSettleTile = 16;
 constexpr std::uint64_t kSettleMinArea = 16;
 constexpr std::uint32_t kNoObject = 0xffffffffu;
+// The one-tile pass is split between threads (shade_split) only with at least this many triangles
+// per thread: below it a second parallel phase costs more than it saves.
+constexpr std::uint64_t kSplitMinTriangles = 256;
 
 
 std::string check_vertex(const Double4& d) {
@@ -118,6 +121,10 @@ struct VisibilityPass::State {
     std::vector<std::vector<Fragment>> frags;             // per tile (scratch)
     std::vector<std::vector<std::uint8_t>> need;          // per tile (scratch): per ref, its queries can pass
     std::vector<std::uint32_t> min1, obj1, min2;          // per pixel, tile-major (one tile = side^2)
+    // The split one-tile shade (shade_split): per part, its minima (side^2 each) and fragments.
+    std::vector<std::vector<std::uint32_t>> part_min1, part_obj1, part_min2;
+    std::vector<std::vector<Fragment>> part_frags;
+    std::vector<std::size_t> part_first;  // per part, its first item; part_first[parts] = the item count
 
     // Front end per item (the recorded draws' own setup, so the same polygons). False when some
     // item failed an input check (bad[i]).
@@ -131,6 +138,19 @@ struct VisibilityPass::State {
     // that may pass against the minimum over the other objects; such items go to hit[].
     void shade(std::span<const VisibilityItem> items, const TileGrid& grid, int width, int height,
                DepthFormat format, std::size_t tile, bool settle);
+    // One tile without settling, on `parts` threads: see shade_split's comment.
+    void shade_split(std::span<const VisibilityItem> items, int side, int width, int height, DepthFormat format,
+                     int parts);
+    // One triangle's fragments into the minima of a tile at (x0, y0)..(x1, y1) of `side` pixels a
+    // row; with `keep`, each fragment's zmax goes to `out` for the query test.
+    __attribute__((always_inline)) void draw(std::span<const VisibilityItem> items, Ref r, bool keep, int x0, int y0,
+                                             int x1, int y1, int side, DepthFormat format, std::uint32_t* tile_min1,
+                                             std::uint32_t* tile_obj1, std::uint32_t* tile_min2,
+                                             std::vector<Fragment>& out) const;
+    // Each fragment of `frags` against the minima: its item goes to hit[] where the query passes.
+    void test_fragments(std::span<const VisibilityItem> items, const std::vector<Fragment>& fragments,
+                        const std::uint32_t* tile_min1, const std::uint32_t* tile_obj1,
+                        const std::uint32_t* tile_min2);
 };
 
 bool VisibilityPass::State::front_end(int width, int height, std::span<const VisibilityItem> items, int threads) {
@@ -213,6 +233,40 @@ void VisibilityPass::State::bin(std::span<const VisibilityItem> items, const Til
     }
 }
 
+inline void VisibilityPass::State::draw(std::span<const VisibilityItem> items, const Ref r, const bool keep, const int x0,
+                                 const int y0, const int x1, const int y1, const int side, const DepthFormat format,
+                                 std::uint32_t* tile_min1, std::uint32_t* tile_obj1, std::uint32_t* tile_min2,
+                                 std::vector<Fragment>& out) const {
+    const detail::BoundsTri& t = tris[r.item][r.tri];
+    const std::uint32_t obj = items[r.item].object;
+    const double mz = t.margin_z;
+    double last_lo = std::numeric_limits<double>::quiet_NaN(), last_hi = last_lo;
+    std::uint32_t zmin = 0, zmax = 0;  // quantized once per distinct depth
+    const detail::PixelRect rect{std::max(x0, t.x0), std::max(y0, t.y0), std::min(x1, t.x1), std::min(y1, t.y1)};
+    detail::bounds_pixels(t, pool[r.item].data(), rect, [&](int px, int py, double zlo, double zhi) {
+        const auto p = static_cast<std::uint32_t>((py - y0) * side + (px - x0));
+        if (!(zlo == last_lo)) {
+            last_lo = zlo;
+            zmin = detail::quantize_down(zlo - mz, format);
+        }
+        if (obj == tile_obj1[p]) {
+            tile_min1[p] = std::min(tile_min1[p], zmin);
+        } else if (zmin < tile_min1[p]) {
+            tile_min2[p] = tile_min1[p];
+            tile_min1[p] = zmin;
+            tile_obj1[p] = obj;
+        } else {
+            tile_min2[p] = std::min(tile_min2[p], zmin);
+        }
+        if (!keep) return;
+        if (!(zhi == last_hi)) {
+            last_hi = zhi;
+            zmax = detail::quantize_up(zhi + mz, format);
+        }
+        out.push_back({r.item, p, zmax});
+    });
+}
+
 // Tiles settled from depth bounds: an item's query can pass at a pixel only if one of its fragments
 // there has zmax >= the minimum zmin over the other objects' fragments there (and the clear value).
 // Every fragment in a tile comes from a triangle binned to it, and its zmin >= the triangle's zq_lo,
@@ -277,34 +331,7 @@ void VisibilityPass::State::shade(std::span<const VisibilityItem> items, const T
     std::fill(tile_obj1, tile_obj1 + tile_pixels, kNoObject);
     std::fill(tile_min2, tile_min2 + tile_pixels, clear);
     const auto draw = [&](const Ref r, const bool keep) __attribute__((always_inline)) {
-        const detail::BoundsTri& t = tris[r.item][r.tri];
-        const std::uint32_t obj = items[r.item].object;
-        const double mz = t.margin_z;
-        double last_lo = std::numeric_limits<double>::quiet_NaN(), last_hi = last_lo;
-        std::uint32_t zmin = 0, zmax = 0;  // quantized once per distinct depth
-        const detail::PixelRect rect{std::max(x0, t.x0), std::max(y0, t.y0), std::min(x1, t.x1), std::min(y1, t.y1)};
-        detail::bounds_pixels(t, pool[r.item].data(), rect, [&](int px, int py, double zlo, double zhi) {
-            const auto p = static_cast<std::uint32_t>((py - y0) * side + (px - x0));
-            if (!(zlo == last_lo)) {
-                last_lo = zlo;
-                zmin = detail::quantize_down(zlo - mz, format);
-            }
-            if (obj == tile_obj1[p]) {
-                tile_min1[p] = std::min(tile_min1[p], zmin);
-            } else if (zmin < tile_min1[p]) {
-                tile_min2[p] = tile_min1[p];
-                tile_min1[p] = zmin;
-                tile_obj1[p] = obj;
-            } else {
-                tile_min2[p] = std::min(tile_min2[p], zmin);
-            }
-            if (!keep) return;
-            if (!(zhi == last_hi)) {
-                last_hi = zhi;
-                zmax = detail::quantize_up(zhi + mz, format);
-            }
-            tile_frags.push_back({r.item, p, zmax});
-        });
+        this->draw(items, r, keep, x0, y0, x1, y1, side, format, tile_min1, tile_obj1, tile_min2, tile_frags);
     };
     if (one_tile) {
         for (std::size_t i = 0; i < items.size(); ++i)
@@ -315,11 +342,17 @@ void VisibilityPass::State::shade(std::span<const VisibilityItem> items, const T
     } else {
         for (const Ref& r : tile_bin) draw(r, true);
     }
-    // min1 is the minimum over all objects (with the clear value) and min2 the minimum over the
-    // objects other than obj1's, so the minimum over the objects other than o is min2 when o is
-    // obj1 and min1 otherwise (ties between objects: then min2 == min1).
+    test_fragments(items, tile_frags, tile_min1, tile_obj1, tile_min2);
+}
+
+// min1 is the minimum over all objects (with the clear value) and min2 the minimum over the
+// objects other than obj1's, so the minimum over the objects other than o is min2 when o is obj1
+// and min1 otherwise (ties between objects: then min2 == min1).
+void VisibilityPass::State::test_fragments(std::span<const VisibilityItem> items, const std::vector<Fragment>& fragments,
+                                           const std::uint32_t* tile_min1, const std::uint32_t* tile_obj1,
+                                           const std::uint32_t* tile_min2) {
     std::uint32_t last = kNoObject;
-    for (const Fragment& f : tile_frags) {
+    for (const Fragment& f : fragments) {
         if (f.item == last) continue;
         const std::uint32_t other = items[f.item].object == tile_obj1[f.pixel] ? tile_min2[f.pixel] : tile_min1[f.pixel];
         if (f.zmax >= other) {  // the GEQUAL query passes here
@@ -327,6 +360,78 @@ void VisibilityPass::State::shade(std::span<const VisibilityItem> items, const T
             last = f.item;
         }
     }
+}
+
+// The one-tile pass split by items (issue #16: R-CULLIDE's 32^2 views are one tile, so the tile
+// loop gave a second thread nothing). What the pass computes per pixel does not depend on the order
+// of the triangles: the minimum zmin over all objects and over the objects other than the one that
+// holds it. So the items are cut into `parts` runs of about equal pixel area; each run's triangles
+// go into the run's own minima (and its fragments into its own list); the runs' minima are merged
+// pixel by pixel; then each run's fragments are tested against the merged minima. Merging (m1, o1,
+// m2) records keeps their meaning exactly: the smaller m1 wins with its object, and m2 becomes the
+// minimum over the objects other than that one, which from the other record is its m2 if it holds
+// the same object and its m1 otherwise. Every fragment then meets the same value as in the serial
+// pass, so hit[] is the same bit for bit, for any number of parts.
+void VisibilityPass::State::shade_split(std::span<const VisibilityItem> items, const int side, const int width,
+                                        const int height, const DepthFormat format, const int parts) {
+    const auto n_parts = static_cast<std::size_t>(parts);
+    const std::size_t tile_pixels = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
+    if (part_min1.size() < n_parts) {
+        part_min1.resize(n_parts);
+        part_obj1.resize(n_parts);
+        part_min2.resize(n_parts);
+        part_frags.resize(n_parts);
+    }
+    // Cut by cumulative pixel area (the fill is the cost), at item boundaries: the input decides it.
+    std::uint64_t total = 0;
+    for (std::size_t i = 0; i < items.size(); ++i) total += area[i];
+    part_first.assign(n_parts + 1, items.size());
+    part_first[0] = 0;
+    {
+        std::uint64_t sum = 0;
+        std::size_t part = 1;
+        for (std::size_t i = 0; i < items.size() && part < n_parts; ++i) {
+            // Item i starts part `part` once the items before it hold part/parts of the area.
+            while (part < n_parts && sum * n_parts >= total * part) part_first[part++] = i;
+            sum += area[i];
+        }
+    }
+    const std::uint32_t clear = DepthTarget::encode_clear(1.0, format);
+    const int x1 = width - 1, y1 = height - 1;
+    detail::parallel_for(parts, n_parts, [&](std::size_t part) {
+        auto& m1 = part_min1[part];
+        auto& o1 = part_obj1[part];
+        auto& m2 = part_min2[part];
+        m1.assign(tile_pixels, clear);
+        o1.assign(tile_pixels, kNoObject);
+        m2.assign(tile_pixels, clear);
+        auto& out = part_frags[part];
+        out.clear();
+        for (std::size_t i = part_first[part]; i < part_first[part + 1]; ++i)
+            for (std::size_t k = 0; k < tris[i].size(); ++k)
+                draw(items, {static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)}, true, 0, 0, x1, y1, side,
+                     format, m1.data(), o1.data(), m2.data(), out);
+    });
+    // Merge into part 0 (a few thousand pixels: serial).
+    std::uint32_t* a1 = part_min1[0].data();
+    std::uint32_t* ao = part_obj1[0].data();
+    std::uint32_t* a2 = part_min2[0].data();
+    for (std::size_t part = 1; part < n_parts; ++part) {
+        const std::uint32_t* b1 = part_min1[part].data();
+        const std::uint32_t* bo = part_obj1[part].data();
+        const std::uint32_t* b2 = part_min2[part].data();
+        for (std::size_t p = 0; p < tile_pixels; ++p) {
+            if (b1[p] < a1[p]) {
+                a2[p] = std::min(b2[p], ao[p] == bo[p] ? a2[p] : a1[p]);
+                a1[p] = b1[p];
+                ao[p] = bo[p];
+            } else {
+                a2[p] = std::min(a2[p], bo[p] == ao[p] ? b2[p] : b1[p]);
+            }
+        }
+    }
+    detail::parallel_for(parts, n_parts,
+                         [&](std::size_t part) { test_fragments(items, part_frags[part], a1, ao, a2); });
 }
 
 VisibilityPass::VisibilityPass() : s_(std::make_unique<State>()) {}
@@ -369,8 +474,12 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
         s.min2.resize(pixels);
     }
     s.hit.assign(items.size(), 0);
-    detail::parallel_for(threads, grid.count(),
-                         [&](std::size_t tile) { s.shade(items, grid, width, height, format, tile, settle); });
+    if (grid.count() == 1 && !settle && threads > 1 && count >= kSplitMinTriangles * static_cast<std::uint64_t>(threads)) {
+        s.shade_split(items, side, width, height, format, threads);
+    } else {
+        detail::parallel_for(threads, grid.count(),
+                             [&](std::size_t tile) { s.shade(items, grid, width, height, format, tile, settle); });
+    }
 
     std::vector<std::uint8_t> result(s.hit.begin(), s.hit.begin() + static_cast<std::ptrdiff_t>(items.size()));
     return result;

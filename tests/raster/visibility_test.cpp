@@ -144,6 +144,38 @@ TEST_CASE("The fused visibility pass gives the two recorded passes' answers, any
     CHECK(hidden > 20);
 }
 
+TEST_CASE("The fused visibility pass split between threads (one tile, many small triangles) gives the recorded answers") {
+    // R-CULLIDE's 32^2 sub-object views: one tile, thousands of triangles of a pixel or two. With
+    // more than 256 triangles per thread the pass cuts the items into one run per thread, each with
+    // its own minima, and merges them (visibility.cpp, shade_split). Hundreds of objects, so that the
+    // runs' minima hold different objects at the same pixel and the merge decides which one wins;
+    // flat triangles at one shared depth make ties between runs.
+    test::Rng rng(20261126);
+    const DepthFormat formats[] = {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F};
+    const int sizes[][2] = {{32, 32}, {37, 23}, {64, 64}};
+    raster::VisibilityPass pass;
+    int visible = 0, hidden = 0;
+    for (int rep = 0; rep < 12; ++rep) {
+        const Scene s = random_scene(rng, 500 + static_cast<int>(rng.below(300)), 0.05);
+        std::size_t triangles = 0;
+        for (const auto& idx : s.item_indices) triangles += idx.size() / 3;
+        REQUIRE(triangles >= 256 * 8);  // every thread count below splits
+        const DepthFormat f = formats[rep % 3];
+        const int w = sizes[(rep / 3) % 3][0], h = sizes[(rep / 3) % 3][1];
+        CAPTURE(rep);
+        const std::vector<std::uint8_t> want = recorded(s, w, h, f, 1, true);
+        for (const int threads : {1, 2, 3, 8}) {
+            CAPTURE(threads);
+            auto got = pass.run(w, h, f, items_of(s), threads);
+            REQUIRE_MESSAGE(got.ok(), got.error().message);
+            CHECK(got.value() == want);
+        }
+        for (auto v : want) (v != 0 ? hidden : visible) += 1;
+    }
+    CHECK(visible > 100);
+    CHECK(hidden > 100);
+}
+
 TEST_CASE("The fused visibility pass with large triangles (tiles settled from depth bounds) gives the recorded answers") {
     // Triangles a few times larger than above: their boxes average more than kSettleMinArea pixels,
     // so the pass settles 16-pixel tiles from the triangles' depth bounds and skips items already
