@@ -1,6 +1,7 @@
 // cullide_detail.h (private): view helpers of cullide.cpp shared with quick_cullide.cpp.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <span>
 
@@ -34,5 +35,25 @@ void widen(double& lo, double& hi);
 [[nodiscard]] Result<ViewSize> check_visibility_inputs(std::span<const Mesh> objects,
                                                        std::span<const std::uint32_t> active,
                                                        const VisibilityOptions& o, VisibilityMode mode);
+
+// The order of one recorded Quick-CULLIDE pass over n items (quick_cullide.cpp, and the recorded
+// form of raster::WindowedPasses): forward, for k = 0 .. n-1, query(k), then write(d) for every item
+// d not yet written whose window ends at or before k (near_hi(d) <= k; near_hi non-decreasing), except
+// after the last query; backward the mirror image with near_lo (non-decreasing too). The callbacks
+// decide themselves whether an item is queried or drawn.
+template <class NearLo, class NearHi, class Query, class Write>
+void quick_pass_schedule(std::size_t n, bool forward, NearLo&& near_lo, NearHi&& near_hi, Query&& query, Write&& write) {
+    std::size_t cursor = 0;  // draws scheduled so far, counted from the pass's start
+    for (std::size_t step = 0; step < n; ++step) {
+        const std::size_t k = forward ? step : n - 1 - step;
+        query(k);
+        if (step + 1 == n) break;  // nothing is queried after the last item
+        for (; cursor < n; ++cursor) {
+            const std::size_t d = forward ? cursor : n - 1 - cursor;
+            if (forward ? near_hi(d) > k : near_lo(d) < k) break;
+            write(d);
+        }
+    }
+}
 
 }  // namespace cullide::detail

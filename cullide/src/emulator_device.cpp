@@ -98,6 +98,41 @@ Result<std::vector<std::uint8_t>> EmulatorDevice::visibility_pass(ViewSize size,
     return std::move(r).value();
 }
 
+// Quick-CULLIDE's two passes with each item rasterized once (raster/visibility.h), the same tags as
+// the recorded passes (tests/cullide/quick_cullide_test.cpp compares the two).
+Result<std::vector<std::uint8_t>> EmulatorDevice::quick_view(ViewSize size, raster::DepthFormat format,
+                                                             std::span<const raster::WindowedItem> items,
+                                                             std::span<const std::uint8_t> tags) {
+    if (static_cast<std::int64_t>(size.width()) * size.height() > raster::WindowedPasses::kMaxWindowedPixels)
+        return recorded_quick_view(size, format, items, tags);
+    if (tags.size() != items.size())
+        return Error{"emulator device: quick_view: " + std::to_string(tags.size()) + " tags for " +
+                     std::to_string(items.size()) + " items"};
+    // Items proven apart both ways (BFV) are neither queried nor written by either pass (pass 1 adds
+    // only FFV, so pass 2 queries the same items and writes a subset of pass 1's).
+    std::vector<raster::WindowedItem> prepared_items(items.begin(), items.end());
+    for (std::size_t k = 0; k < items.size(); ++k)
+        prepared_items[k].used = (tags[k] & (kQuickFFV | kQuickSFV)) != (kQuickFFV | kQuickSFV);
+    thread_local raster::WindowedPasses passes;  // buffers kept, no answer kept (as visibility_pass)
+    raster::Result<std::size_t> prepared = passes.prepare(size.width(), size.height(), format, prepared_items, threads_);
+    if (!prepared) return Error{"emulator device: " + prepared.error().message};
+    std::vector<std::uint8_t> out(tags.begin(), tags.end());
+    std::vector<std::uint8_t> query(items.size()), write(items.size());
+    for (const bool forward : {true, false}) {  // pass 2 reads the tags pass 1 left
+        const std::uint8_t proven = forward ? kQuickFFV : kQuickSFV;
+        const std::uint8_t other = forward ? kQuickSFV : kQuickFFV;
+        for (std::size_t k = 0; k < items.size(); ++k) {
+            query[k] = (out[k] & proven) ? 0 : 1;
+            write[k] = (out[k] & other) ? 0 : 1;
+        }
+        raster::Result<std::vector<std::uint8_t>> passed = passes.run(forward, query, write);
+        if (!passed) return Error{"emulator device: " + passed.error().message};
+        for (std::size_t k = 0; k < items.size(); ++k)
+            if (query[k] && !passed.value()[k]) out[k] |= proven;
+    }
+    return out;
+}
+
 }  // namespace detail
 
 std::unique_ptr<QueryDevice> make_emulator_device(int threads) {

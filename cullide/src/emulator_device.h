@@ -31,6 +31,11 @@ class EmulatorDevice final : public QueryDevice {
         std::span<const raster::CommandBatch* const> batches) override;
     Result<std::vector<std::uint8_t>> visibility_pass(ViewSize size, raster::DepthFormat format,
                                                       std::span<const raster::VisibilityItem> items) override;
+    // Natively (raster::WindowedPasses) on targets up to WindowedPasses::kMaxWindowedPixels, where
+    // its per-pixel records stay small; recorded above that.
+    Result<std::vector<std::uint8_t>> quick_view(ViewSize size, raster::DepthFormat format,
+                                                 std::span<const raster::WindowedItem> items,
+                                                 std::span<const std::uint8_t> tags) override;
     std::string name() const override { return "emulator"; }
 
     // The current target (nullptr before the first clear), for tests of the partial clear.

@@ -6,6 +6,8 @@
 #include <string>
 #include <utility>
 
+#include "cullide_detail.h"
+
 namespace cullide {
 
 Result<std::vector<std::uint8_t>> QueryDevice::visibility_pass(ViewSize size, raster::DepthFormat format,
@@ -77,6 +79,55 @@ Result<std::vector<std::uint8_t>> QueryDevice::recorded_visibility_pass(
         for (std::size_t i = 0; i < items.size(); ++i) passed[i] |= res[query[pass][i]] != 0 ? 1 : 0;
     }
     return passed;
+}
+
+Result<std::vector<std::uint8_t>> QueryDevice::quick_view(ViewSize size, raster::DepthFormat format,
+                                                          std::span<const raster::WindowedItem> items,
+                                                          std::span<const std::uint8_t> tags) {
+    return recorded_quick_view(size, format, items, tags);
+}
+
+Result<std::vector<std::uint8_t>> QueryDevice::recorded_quick_view(ViewSize size, raster::DepthFormat format,
+                                                                   std::span<const raster::WindowedItem> items,
+                                                                   std::span<const std::uint8_t> tags) {
+    if (tags.size() != items.size())
+        return Error{name() + ": quick_view: " + std::to_string(tags.size()) + " tags for " +
+                     std::to_string(items.size()) + " items"};
+    raster::DrawState query_state;
+    query_state.mode = raster::RasterMode::ExactBounds;
+    query_state.depth_func = raster::DepthFunc::GEqual;
+    query_state.depth_write = false;
+    raster::DrawState write_state = query_state;
+    write_state.depth_func = raster::DepthFunc::LEqual;
+    write_state.depth_write = true;
+    std::vector<std::uint8_t> out(tags.begin(), tags.end());
+    std::vector<std::uint32_t> query(items.size());
+    for (const bool forward : {true, false}) {  // pass 2 reads the tags pass 1 left
+        const std::uint8_t proven = forward ? kQuickFFV : kQuickSFV;
+        const std::uint8_t other = forward ? kQuickSFV : kQuickFFV;
+        raster::CommandBatch batch(size.width(), size.height());
+        detail::quick_pass_schedule(
+            items.size(), forward, [&](std::size_t k) { return items[k].near_lo; },
+            [&](std::size_t k) { return items[k].near_hi; },
+            [&](std::size_t k) {
+                if (out[k] & proven) return;
+                query[k] = batch.begin_query(raster::QueryKind::AnySamplesPassed);
+                batch.draw(items[k].mesh, query_state);
+                batch.end_query();
+            },
+            [&](std::size_t d) {
+                if (!(out[d] & other)) batch.draw(items[d].mesh, write_state);
+            });
+        if (Status s = clear(size.width(), size.height(), format); !s) return s.error();
+        Result<raster::QueryResults> r = execute(batch);
+        if (!r) return r.error();
+        if (r.value().size() != batch.query_kinds().size())
+            return Error{name() + " returned " + std::to_string(r.value().size()) + " query results for " +
+                         std::to_string(batch.query_kinds().size()) + " queries"};
+        for (std::size_t k = 0; k < items.size(); ++k)
+            if (!(out[k] & proven) && r.value()[query[k]] == 0) out[k] |= proven;
+    }
+    return out;
 }
 
 }  // namespace cullide

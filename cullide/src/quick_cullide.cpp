@@ -92,54 +92,59 @@ Status run_device(QueryDevice& device, const raster::CommandBatch& batch, ViewSi
     return Status{};
 }
 
-// This view's clip coordinates of every geometry with a live item.
+// This view's clip coordinates of every geometry with a live item, one geometry per parallel job
+// (each writes only its own; the first failure in geometry order is reported).
 Status transform_geoms(std::vector<Geom>& geoms, const std::vector<char>& geom_live, const raster::OrthoView& view,
-                       VisibilityMode mode, raster::RasterRules rules) {
-    for (std::size_t gi = 0; gi < geoms.size(); ++gi) {
-        if (!geom_live[gi]) continue;
-        Geom& g = geoms[gi];
+                       VisibilityMode mode, raster::RasterRules rules, int threads) {
+    std::vector<std::size_t> live;
+    for (std::size_t gi = 0; gi < geoms.size(); ++gi)
+        if (geom_live[gi]) live.push_back(gi);
+    std::vector<std::string> errors(live.size());
+    detail::parallel_chunks(threads, live.size(), [&](std::size_t j) {
+        Geom& g = geoms[live[j]];
         raster::Result<std::vector<raster::Double4>> c = raster::ortho_view_to_clip(view, g.positions);
-        if (!c) return Error{"view transform: " + c.error().message};
+        if (!c) {
+            errors[j] = "view transform: " + c.error().message;
+            return;
+        }
         if (mode == VisibilityMode::ExactBounds) {
             g.clip_d = std::move(c).value();
-            continue;
+            return;
         }
         g.clip.resize(c.value().size());
         for (std::size_t i = 0; i < g.clip.size(); ++i) {
             const raster::Double4& d = c.value()[i];
             g.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), detail::gl_exact_clip_depth(d.z, rules), 1.0f};
         }
-    }
+    });
+    for (const std::string& e : errors)
+        if (!e.empty()) return Error{e};
     return Status{};
 }
 
 // One pass of a view: forward (pass 1) queries items that are not FFV and draws those that are not
 // SFV, item j right after the query of item near_hi[j]; backward (pass 2) the mirror image, with
-// near_lo. Both are non-decreasing in j, so one cursor schedules every deferred draw. Items whose
-// query passes no sample gain the pass's tag; returns how many did.
+// near_lo (detail::quick_pass_schedule). Items whose query passes no sample gain the pass's tag;
+// returns how many did.
 Result<std::uint64_t> run_pass(const std::vector<Geom>& geoms, std::vector<Item>& items, bool forward,
                                const QuickOptions& o, ViewSize size, QueryDevice& device, ViewStats& vs) {
     const std::uint8_t proven = forward ? kFFV : kSFV;  // what this pass proves
     const std::uint8_t other = forward ? kSFV : kFFV;   // items with this tag are not drawn
-    const std::size_t n = items.size();
     raster::CommandBatch batch(size.width(), size.height(), o.gpu_rules);
-    std::size_t cursor = 0;  // draws scheduled so far, counted from the pass's start
-    for (std::size_t step = 0; step < n; ++step) {
-        const std::size_t k = forward ? step : n - 1 - step;
-        Item& it = items[k];
-        if (!(it.tag & proven)) {
+    detail::quick_pass_schedule(
+        items.size(), forward, [&](std::size_t k) { return items[k].near_lo; },
+        [&](std::size_t k) { return items[k].near_hi; },
+        [&](std::size_t k) {
+            Item& it = items[k];
+            if (it.tag & proven) return;
             it.query = batch.begin_query(raster::QueryKind::AnySamplesPassed);
             vs.triangles_rasterized += record_draw(batch, geoms[it.geom], it, o.mode, true);
             batch.end_query();
             ++vs.queries;
-        }
-        if (step + 1 == n) break;  // nothing is queried after the last item
-        for (; cursor < n; ++cursor) {
-            const Item& d = items[forward ? cursor : n - 1 - cursor];
-            if (forward ? d.near_hi > k : d.near_lo < k) break;
-            if (!(d.tag & other)) vs.triangles_rasterized += record_draw(batch, geoms[d.geom], d, o.mode, false);
-        }
-    }
+        },
+        [&](std::size_t d) {
+            if (!(items[d].tag & other)) vs.triangles_rasterized += record_draw(batch, geoms[items[d].geom], items[d], o.mode, false);
+        });
     raster::QueryResults res;
     if (Status s = run_device(device, batch, size, o.depth_format, res); !s) return s.error();
     std::uint64_t changed = 0;
@@ -148,6 +153,57 @@ Result<std::uint64_t> run_pass(const std::vector<Geom>& geoms, std::vector<Item>
             it.tag |= proven;
             ++changed;
         }
+    }
+    return changed;
+}
+
+// The queries and triangles one recorded pass would submit with these tags (run_pass's counts; the
+// native view reports what it replaces).
+void count_pass(const std::vector<Item>& items, const std::vector<std::uint8_t>& tags, bool forward, ViewStats& vs) {
+    const std::uint8_t proven = forward ? kFFV : kSFV;
+    const std::uint8_t other = forward ? kSFV : kFFV;
+    detail::quick_pass_schedule(
+        items.size(), forward, [&](std::size_t k) { return items[k].near_lo; },
+        [&](std::size_t k) { return items[k].near_hi; },
+        [&](std::size_t k) {
+            if (tags[k] & proven) return;
+            ++vs.queries;
+            vs.triangles_rasterized += items[k].count;
+        },
+        [&](std::size_t d) {
+            if (!(tags[d] & other)) vs.triangles_rasterized += items[d].count;
+        });
+}
+
+// Both passes of one exact-bounds view as the device's quick_view (query_device.h: natively on the
+// emulator, raster::WindowedPasses); returns the tags gained.
+Result<std::uint64_t> native_view(const std::vector<Geom>& geoms, std::vector<Item>& items, const QuickOptions& o,
+                                  ViewSize size, QueryDevice& device, ViewStats& vs) {
+    static_assert(kFFV == QueryDevice::kQuickFFV && kSFV == QueryDevice::kQuickSFV);
+    std::vector<raster::WindowedItem> wi(items.size());
+    std::vector<std::uint8_t> tags(items.size());
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        const Item& it = items[i];
+        const Geom& g = geoms[it.geom];
+        wi[i] = {raster::MeshViewD{g.clip_d, std::span<const std::uint32_t>(g.indices)
+                                                 .subspan(std::size_t{it.first} * 3, std::size_t{it.count} * 3)},
+                 it.near_lo, it.near_hi};
+        tags[i] = it.tag;
+    }
+    Result<std::vector<std::uint8_t>> r = device.quick_view(size, o.depth_format, wi, tags);
+    if (!r) return r.error();
+    if (r.value().size() != items.size())
+        return Error{"device returned " + std::to_string(r.value().size()) + " tags for " + std::to_string(items.size()) + " items"};
+    count_pass(items, tags, true, vs);
+    std::vector<std::uint8_t> after_forward(items.size());
+    for (std::size_t i = 0; i < items.size(); ++i)
+        after_forward[i] = static_cast<std::uint8_t>(tags[i] | (r.value()[i] & kFFV));
+    count_pass(items, after_forward, false, vs);
+    std::uint64_t changed = 0;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        const std::uint8_t now = r.value()[i];
+        changed += static_cast<std::uint64_t>(((now & kFFV) && !(tags[i] & kFFV)) + ((now & kSFV) && !(tags[i] & kSFV)));
+        items[i].tag = now;
     }
     return changed;
 }
@@ -180,16 +236,22 @@ Status run_stage(std::vector<Geom>& geoms, std::vector<Item>& items, CullStage s
         const int axis = (first_axis + view) % 3;
         Result<raster::OrthoView> v = detail::make_view(axis, bounds, 0.0, size, o.depth_format);
         if (!v) return v.error();
-        if (Status s = transform_geoms(geoms, geom_live, v.value(), o.mode, o.gpu_rules); !s) return s;
+        if (Status s = transform_geoms(geoms, geom_live, v.value(), o.mode, o.gpu_rules, o.threads); !s) return s;
         ViewStats vs;
         vs.stage = stage;
         vs.axis = axis;
         vs.items_before = live;
         std::uint64_t changed = 0;  // tags gained in this view
-        for (const bool forward : {true, false}) {
-            Result<std::uint64_t> gained = run_pass(geoms, items, forward, o, size, device, vs);
+        if (o.mode == VisibilityMode::ExactBounds && o.fused_visibility) {
+            Result<std::uint64_t> gained = native_view(geoms, items, o, size, device, vs);
             if (!gained) return gained.error();
-            changed += gained.value();
+            changed = gained.value();
+        } else {
+            for (const bool forward : {true, false}) {
+                Result<std::uint64_t> gained = run_pass(geoms, items, forward, o, size, device, vs);
+                if (!gained) return gained.error();
+                changed += gained.value();
+            }
         }
         vs.items_after = count_live(items);
         st.queries += vs.queries;

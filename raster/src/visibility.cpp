@@ -486,3 +486,248 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
 }
 
 }  // namespace raster
+
+namespace raster {
+namespace {
+
+// One item's fragments at one pixel: the smallest zmin (what its write stores) and the largest zmax
+// (what its query tests), encoded as the fused pass encodes them.
+struct PixelRecord {
+    std::uint32_t pixel;
+    std::uint32_t zmin;
+    std::uint32_t zmax;
+};
+
+}  // namespace
+
+struct WindowedPasses::State {
+    // Per chunk of triangles (equal counts of the used items' triangles, in item order: the input
+    // decides the cut, so the records do not depend on the thread count). An item whose triangles
+    // span several chunks has one segment in each: its records are their union (a pixel may appear
+    // in two segments, which changes neither the minimum written nor the query's answer).
+    struct Segment {
+        std::uint32_t item, begin, end;  // records[begin, end) of the chunk
+    };
+    struct Chunk {
+        std::vector<PixelRecord> records;
+        std::vector<Segment> segments;     // in item order
+        std::vector<std::uint32_t> stamp;  // per pixel: 1 + the item whose record is in `slot`
+        std::vector<std::uint32_t> slot;   // per pixel: that record's index in `records`
+        std::vector<detail::BoundsTri> tris;
+        std::vector<detail::BoundsVertex> pool;
+    };
+    std::vector<Chunk> chunks;
+    struct Span {
+        const PixelRecord* begin;
+        const PixelRecord* end;
+    };
+    std::vector<Span> spans;                 // every item's segments, in item order
+    std::vector<std::uint32_t> first_span;   // per item, its first span; then spans.size()
+    std::vector<std::uint64_t> tri_before;   // per item: the used items' triangles before it; then the total
+    std::vector<std::uint8_t> bad;           // per item: an input check failed
+    std::vector<std::uint8_t> used;          // per item: WindowedItem::used
+    std::vector<std::uint32_t> near_lo, near_hi;
+    mutable std::vector<std::uint32_t> depth;  // run()'s stored depth per pixel
+    std::uint32_t clear = 0;
+    std::size_t pixels = 0;
+    bool ready = false;
+};
+
+WindowedPasses::WindowedPasses() : s_(std::make_unique<State>()) {}
+WindowedPasses::~WindowedPasses() = default;
+
+Result<std::size_t> WindowedPasses::prepare(int width, int height, DepthFormat format,
+                                            std::span<const WindowedItem> items, int threads) {
+    State& s = *s_;
+    s.ready = false;
+    if (width < 1 || height < 1 || static_cast<std::int64_t>(width) * height > kMaxWindowedPixels)
+        return Error{"windowed passes: target " + std::to_string(width) + "x" + std::to_string(height) +
+                     " is outside 1.." + std::to_string(kMaxWindowedPixels) + " pixels"};
+    if (format != DepthFormat::D16 && format != DepthFormat::D24 && format != DepthFormat::D32F)
+        return Error{"windowed passes: invalid depth format"};
+    if (threads < 0)
+        return Error{"windowed passes: threads = " + std::to_string(threads) +
+                     " is out of range: it must be >= 0 (0 = all hardware threads)"};
+    if (items.size() >= kNoObject) return Error{"windowed passes: too many items (limit 2^32 - 2)"};
+    const std::size_t n = items.size();
+    for (std::size_t i = 0; i < n; ++i) {
+        const WindowedItem& it = items[i];
+        if (it.mesh.indices.size() % 3 != 0)
+            return Error{"windowed passes: item " + std::to_string(i) + ": index count " +
+                         std::to_string(it.mesh.indices.size()) + " is not a multiple of 3"};
+        if (it.near_lo > it.near_hi || it.near_hi >= n ||
+            (i > 0 && (it.near_lo < items[i - 1].near_lo || it.near_hi < items[i - 1].near_hi)))
+            return Error{"windowed passes: item " + std::to_string(i) + ": window [" + std::to_string(it.near_lo) +
+                         ", " + std::to_string(it.near_hi) +
+                         "] is not inside the item list or not after the previous item's"};
+    }
+    threads = detail::effective_threads(threads);
+    s.pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+    s.clear = DepthTarget::encode_clear(1.0, format);
+    s.bad.assign(n, 0);
+    s.near_lo.resize(n);
+    s.near_hi.resize(n);
+    s.used.resize(n);
+    s.tri_before.resize(n + 1);
+    std::uint64_t triangles = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        s.near_lo[i] = items[i].near_lo;
+        s.near_hi[i] = items[i].near_hi;
+        s.used[i] = items[i].used ? 1 : 0;
+        s.tri_before[i] = triangles;
+        if (items[i].used) triangles += items[i].mesh.indices.size() / 3;
+    }
+    s.tri_before[n] = triangles;
+    // A few chunks per thread, none under kChunkMinTriangles triangles (each clears its stamps).
+    constexpr std::uint64_t kChunkMinTriangles = 512;
+    const std::uint64_t n_chunks64 = std::max<std::uint64_t>(
+        1, std::min<std::uint64_t>(static_cast<std::uint64_t>(threads) * 4, triangles / kChunkMinTriangles));
+    const auto n_chunks = static_cast<std::size_t>(n_chunks64);
+    if (s.chunks.size() < n_chunks) s.chunks.resize(n_chunks);
+    detail::FrontEndParams params{};
+    params.target_width = width;
+    params.target_height = height;
+    params.viewport = Viewport{0, 0, width, height};
+    params.cull_face = CullFace::None;
+    params.front_face = FrontFace::CCW;
+    detail::parallel_for(threads, n_chunks, [&](std::size_t c) {
+        State::Chunk& ch = s.chunks[c];
+        ch.records.clear();
+        ch.segments.clear();
+        if (ch.stamp.size() < s.pixels) {
+            ch.stamp.resize(s.pixels);
+            ch.slot.resize(s.pixels);
+        }
+        std::fill(ch.stamp.begin(), ch.stamp.begin() + static_cast<std::ptrdiff_t>(s.pixels), 0u);
+        // This chunk's triangles: [t0, t1) of the used items' triangles in item order.
+        const std::uint64_t t0 = triangles * c / n_chunks64, t1 = triangles * (c + 1) / n_chunks64;
+        if (t0 == t1) return;
+        // The item holding triangle t0: the last item with tri_before <= t0 that has a triangle there.
+        std::size_t i = static_cast<std::size_t>(
+            std::upper_bound(s.tri_before.begin(), s.tri_before.begin() + static_cast<std::ptrdiff_t>(n), t0) -
+            s.tri_before.begin() - 1);
+        for (; i < n && s.tri_before[i] < t1; ++i) {
+            if (!items[i].used) continue;
+            const MeshViewD& m = items[i].mesh;
+            const std::uint64_t item_tris = m.indices.size() / 3;
+            const std::uint64_t k0 = std::max(t0, s.tri_before[i]) - s.tri_before[i];
+            const std::uint64_t k1 = std::min(t1, s.tri_before[i] + item_tris) - s.tri_before[i];
+            if (k0 >= k1) continue;
+            const auto begin = static_cast<std::uint32_t>(ch.records.size());
+            const auto tag = static_cast<std::uint32_t>(i + 1);
+            const std::size_t nv = m.vertices.size();
+            for (std::uint64_t tri = k0; tri < k1; ++tri) {
+                const std::size_t k = static_cast<std::size_t>(tri) * 3;
+                const std::uint32_t ia = m.indices[k], ib = m.indices[k + 1], ic = m.indices[k + 2];
+                if (ia >= nv || ib >= nv || ic >= nv || !valid_vertex(m.vertices[ia]) || !valid_vertex(m.vertices[ib]) ||
+                    !valid_vertex(m.vertices[ic])) {
+                    s.bad[i] = 1;  // (only ever set to 1: chunks sharing an item agree)
+                    break;
+                }
+                ch.tris.clear();
+                ch.pool.clear();
+                detail::setup_bounds_triangle(params, m.vertices[ia], m.vertices[ib], m.vertices[ic],
+                                              static_cast<std::uint32_t>(i), ch.tris, ch.pool);
+                if (ch.tris.empty()) continue;
+                const detail::BoundsTri& t = ch.tris.front();
+                const double mz = t.margin_z;
+                double last_lo = std::numeric_limits<double>::quiet_NaN(), last_hi = last_lo;
+                std::uint32_t zmin = 0, zmax = 0;  // quantized once per distinct depth
+                detail::bounds_pixels(t, ch.pool.data(), detail::PixelRect{t.x0, t.y0, t.x1, t.y1},
+                                      [&](int px, int py, double zlo, double zhi) {
+                                          if (!(zlo == last_lo)) {
+                                              last_lo = zlo;
+                                              zmin = detail::quantize_down(zlo - mz, format);
+                                          }
+                                          if (!(zhi == last_hi)) {
+                                              last_hi = zhi;
+                                              zmax = detail::quantize_up(zhi + mz, format);
+                                          }
+                                          const auto p = static_cast<std::uint32_t>(py * width + px);
+                                          if (ch.stamp[p] != tag) {
+                                              ch.stamp[p] = tag;
+                                              ch.slot[p] = static_cast<std::uint32_t>(ch.records.size());
+                                              ch.records.push_back({p, zmin, zmax});
+                                          } else {
+                                              PixelRecord& r = ch.records[ch.slot[p]];
+                                              r.zmin = std::min(r.zmin, zmin);
+                                              r.zmax = std::max(r.zmax, zmax);
+                                          }
+                                      });
+            }
+            ch.segments.push_back({static_cast<std::uint32_t>(i), begin, static_cast<std::uint32_t>(ch.records.size())});
+        }
+    });
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!s.bad[i]) continue;
+        std::vector<VisibilityItem> as_items(n);
+        for (std::size_t j = 0; j < n; ++j) as_items[j].mesh = items[j].mesh;
+        Error e = validate(as_items);
+        e.message.replace(0, std::string("visibility pass").size(), "windowed passes");
+        return e;
+    }
+    // Every item's spans, in item order (the chunks' segments are in item order, chunk after chunk).
+    s.spans.clear();
+    s.first_span.assign(n + 1, 0);
+    std::size_t records = 0;
+    for (std::size_t c = 0; c < n_chunks; ++c) {
+        const State::Chunk& ch = s.chunks[c];
+        records += ch.records.size();
+        for (const State::Segment& g : ch.segments) {
+            s.spans.push_back({ch.records.data() + g.begin, ch.records.data() + g.end});
+            ++s.first_span[g.item + 1];
+        }
+    }
+    for (std::size_t i = 0; i < n; ++i) s.first_span[i + 1] += s.first_span[i];
+    s.ready = true;
+    return records;
+}
+
+Result<std::vector<std::uint8_t>> WindowedPasses::run(bool forward, std::span<const std::uint8_t> query,
+                                                      std::span<const std::uint8_t> write) const {
+    const State& s = *s_;
+    if (!s.ready) return Error{"windowed passes: run without a successful prepare"};
+    const std::size_t n = s.used.size();
+    if (query.size() != n || write.size() != n)
+        return Error{"windowed passes: masks of " + std::to_string(query.size()) + " and " +
+                     std::to_string(write.size()) + " entries for " + std::to_string(n) + " items"};
+    for (std::size_t i = 0; i < n; ++i)
+        if (!s.used[i] && (query[i] != 0 || write[i] != 0))
+            return Error{"windowed passes: item " + std::to_string(i) + " was prepared as unused"};
+    std::vector<std::uint8_t> passed(n, 0);
+    s.depth.assign(s.pixels, s.clear);
+    std::uint32_t* depth = s.depth.data();
+    const auto write_item = [&](std::size_t d) {
+        if (write[d] == 0) return;
+        for (std::uint32_t g = s.first_span[d]; g < s.first_span[d + 1]; ++g)
+            for (const PixelRecord* r = s.spans[g].begin; r != s.spans[g].end; ++r)
+                depth[r->pixel] = std::min(depth[r->pixel], r->zmin);
+    };
+    const auto query_item = [&](std::size_t k) {
+        if (query[k] == 0) return;
+        for (std::uint32_t g = s.first_span[k]; g < s.first_span[k + 1]; ++g) {
+            for (const PixelRecord* r = s.spans[g].begin; r != s.spans[g].end; ++r) {
+                if (r->zmax >= depth[r->pixel]) {  // the GEQUAL query passes here
+                    passed[k] = 1;
+                    return;
+                }
+            }
+        }
+    };
+    if (forward) {
+        std::size_t d = 0;  // items written so far
+        for (std::size_t k = 0; k < n; ++k) {
+            for (; d < n && s.near_hi[d] < k; ++d) write_item(d);
+            query_item(k);
+        }
+    } else {
+        std::size_t d = n;  // items n-1 .. d written so far
+        for (std::size_t k = n; k-- > 0;) {
+            for (; d > 0 && s.near_lo[d - 1] > k; --d) write_item(d - 1);
+            query_item(k);
+        }
+    }
+    return passed;
+}
+
+}  // namespace raster

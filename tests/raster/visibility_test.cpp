@@ -299,3 +299,183 @@ TEST_CASE("Object views are subsumed by sub-object views: an object is fully vis
     CHECK(objects_hidden > 10);
     CHECK(mixed > 5);
 }
+
+// ---- WindowedPasses (Quick-CULLIDE's passes, each item rasterized once) --------------------------
+
+namespace {
+
+// Random non-decreasing windows [lo, hi] over n items: an object's items (hi = its last item, lo =
+// its first, as Quick-CULLIDE without self-collision), or a band of width w around each item (as
+// with self-collision), or a mix of both shapes across the list.
+void random_windows(test::Rng& rng, std::size_t n, std::vector<std::uint32_t>& lo, std::vector<std::uint32_t>& hi,
+                    const std::vector<std::uint32_t>& object) {
+    lo.resize(n);
+    hi.resize(n);
+    const int shape = static_cast<int>(rng.below(3));
+    const auto w = static_cast<std::uint32_t>(rng.below(4));
+    for (std::size_t i = 0; i < n; ++i) {
+        if (shape == 0 || (shape == 2 && object[i] % 2 == 0)) {
+            std::size_t s = i, e = i;
+            while (s > 0 && object[s - 1] == object[i]) --s;
+            while (e + 1 < n && object[e + 1] == object[i]) ++e;
+            lo[i] = static_cast<std::uint32_t>(s);
+            hi[i] = static_cast<std::uint32_t>(e);
+        } else {
+            lo[i] = static_cast<std::uint32_t>(i >= w ? i - w : 0);
+            hi[i] = static_cast<std::uint32_t>(std::min<std::size_t>(n - 1, i + w));
+        }
+    }
+    for (std::size_t i = 1; i < n; ++i) {  // the mixed shape: make both bounds non-decreasing
+        lo[i] = std::max(lo[i], lo[i - 1]);
+        hi[i] = std::max(hi[i], hi[i - 1]);
+        lo[i] = std::min(lo[i], hi[i]);
+    }
+}
+
+// The recorded pass (raster/visibility.h): forward, for each k query item k, then write every item not
+// yet written whose window ends at or before k (not after the last query); backward mirrored.
+std::vector<std::uint8_t> recorded_windowed(const Scene& s, const std::vector<std::uint32_t>& lo,
+                                            const std::vector<std::uint32_t>& hi, const std::vector<std::uint8_t>& query,
+                                            const std::vector<std::uint8_t>& write, bool forward, int w, int h,
+                                            DepthFormat f) {
+    const std::size_t n = s.item_indices.size();
+    raster::DrawState q;
+    q.mode = raster::RasterMode::ExactBounds;
+    q.depth_func = raster::DepthFunc::GEqual;
+    q.depth_write = false;
+    raster::DrawState d = q;
+    d.depth_func = raster::DepthFunc::LEqual;
+    d.depth_write = true;
+    raster::CommandBatch batch(w, h);
+    std::vector<std::int64_t> slot(n, -1);
+    std::size_t cursor = 0;
+    for (std::size_t step = 0; step < n; ++step) {
+        const std::size_t k = forward ? step : n - 1 - step;
+        if (query[k]) {
+            slot[k] = batch.begin_query(raster::QueryKind::AnySamplesPassed);
+            batch.draw(raster::MeshViewD{s.vertices, s.item_indices[k]}, q);
+            batch.end_query();
+        }
+        if (step + 1 == n) break;
+        for (; cursor < n; ++cursor) {
+            const std::size_t j = forward ? cursor : n - 1 - cursor;
+            if (forward ? hi[j] > k : lo[j] < k) break;
+            if (write[j]) batch.draw(raster::MeshViewD{s.vertices, s.item_indices[j]}, d);
+        }
+    }
+    auto target = raster::DepthTarget::create(w, h, f);
+    REQUIRE(target.ok());
+    auto r = raster::execute_reference(target.value(), batch, raster::ExecuteOptions{1});
+    REQUIRE_MESSAGE(r.ok(), r.error().message);
+    std::vector<std::uint8_t> passed(n, 0);
+    for (std::size_t k = 0; k < n; ++k)
+        if (slot[k] >= 0 && r.value()[static_cast<std::size_t>(slot[k])] != 0) passed[k] = 1;
+    return passed;
+}
+
+}  // namespace
+
+TEST_CASE("WindowedPasses (each item rasterized once) give the recorded windowed passes' answers") {
+    test::Rng rng(20261127);
+    const DepthFormat formats[] = {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F};
+    const int sizes[][2] = {{16, 16}, {37, 23}, {64, 64}};
+    raster::WindowedPasses passes;  // reused across calls, as the device does
+    int passed = 0, failed = 0;
+    for (int rep = 0; rep < 90; ++rep) {
+        // Small scenes, scenes of hundreds of objects (several chunks of triangles), and every fifth
+        // with runs of up to 64 items merged into one (items whose triangles span chunks, as
+        // Quick-CULLIDE's whole objects do).
+        Scene s = random_scene(rng, 2 + static_cast<int>(rng.below(rep % 2 == 0 ? 12 : 800)), rep % 3 == 0 ? 1.0 : 0.2);
+        if (rep % 5 == 4) {
+            Scene merged;
+            merged.vertices = s.vertices;
+            merged.objects = s.objects;
+            const std::size_t run = 1 + rng.below(64);
+            for (std::size_t b = 0; b < s.item_indices.size(); b += run) {
+                std::vector<std::uint32_t> idx;
+                for (std::size_t i = b; i < std::min(s.item_indices.size(), b + run); ++i)
+                    idx.insert(idx.end(), s.item_indices[i].begin(), s.item_indices[i].end());
+                merged.item_indices.push_back(std::move(idx));
+                merged.item_object.push_back(s.item_object[b]);
+            }
+            s = std::move(merged);
+        }
+        const std::size_t n = s.item_indices.size();
+        std::vector<std::uint32_t> lo, hi;
+        random_windows(rng, n, lo, hi, s.item_object);
+        std::vector<raster::WindowedItem> items(n);
+        for (std::size_t i = 0; i < n; ++i) items[i] = {raster::MeshViewD{s.vertices, s.item_indices[i]}, lo[i], hi[i]};
+        std::vector<std::uint8_t> query(n), write(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            query[i] = rng.below(5) != 0 ? 1 : 0;
+            write[i] = rng.below(5) != 0 ? 1 : 0;
+        }
+        for (std::size_t i = 0; i < n; ++i) items[i].used = query[i] != 0 || write[i] != 0;
+        const DepthFormat f = formats[rep % 3];
+        const int w = sizes[(rep / 3) % 3][0], h = sizes[(rep / 3) % 3][1];
+        CAPTURE(rep);
+        for (const int threads : {1, 2, 3, 8}) {
+            CAPTURE(threads);
+            auto prepared = passes.prepare(w, h, f, items, threads);
+            REQUIRE_MESSAGE(prepared.ok(), prepared.error().message);
+            for (const bool forward : {true, false}) {
+                CAPTURE(forward);
+                const std::vector<std::uint8_t> want = recorded_windowed(s, lo, hi, query, write, forward, w, h, f);
+                auto got = passes.run(forward, query, write);
+                REQUIRE_MESSAGE(got.ok(), got.error().message);
+                CHECK(got.value() == want);
+                if (threads == 1)
+                    for (std::size_t k = 0; k < n; ++k)
+                        if (query[k]) (want[k] != 0 ? passed : failed) += 1;
+            }
+        }
+    }
+    // Both answers occur, so the comparison can fail either way.
+    CHECK(passed > 100);
+    CHECK(failed > 100);
+}
+
+TEST_CASE("WindowedPasses reject bad input and windows, naming the item") {
+    const std::vector<Double4> v = {{0, 0, 0, 1}, {0.5, 0, 0, 1}, {0, 0.5, 0, 2}, {0, 0.5, 0, 1}};
+    const std::vector<std::uint32_t> bad_w = {0, 1, 2}, good = {0, 1, 3}, bad_index = {0, 1, 9}, bad_count = {0, 1};
+    raster::WindowedPasses passes;
+    const std::vector<std::uint8_t> one = {1}, two = {1, 1};
+    CHECK(!passes.run(true, one, one).ok());  // nothing prepared yet
+    auto r = passes.prepare(16, 16, DepthFormat::D24, std::vector<raster::WindowedItem>{{{v, bad_w}, 0, 0}}, 1);
+    REQUIRE(!r.ok());
+    CHECK(r.error().message.find("windowed passes: item 0: vertex 2 has w = 2") != std::string::npos);
+    CHECK(!passes.run(true, one, one).ok());  // a failed prepare leaves nothing to run
+    r = passes.prepare(16, 16, DepthFormat::D24, std::vector<raster::WindowedItem>{{{v, good}, 0, 0}, {{v, bad_index}, 1, 1}}, 2);
+    REQUIRE(!r.ok());
+    CHECK(r.error().message.find("item 1: index 9 at position 2") != std::string::npos);
+    r = passes.prepare(16, 16, DepthFormat::D24, std::vector<raster::WindowedItem>{{{v, bad_count}, 0, 0}}, 1);
+    REQUIRE(!r.ok());
+    CHECK(r.error().message.find("item 0: index count 2") != std::string::npos);
+    r = passes.prepare(16, 16, DepthFormat::D24, std::vector<raster::WindowedItem>{{{v, good}, 0, 1}, {{v, good}, 0, 0}}, 1);
+    REQUIRE(!r.ok());  // near_hi decreases
+    CHECK(r.error().message.find("item 1: window [0, 0]") != std::string::npos);
+    r = passes.prepare(16, 16, DepthFormat::D24, std::vector<raster::WindowedItem>{{{v, good}, 0, 2}, {{v, good}, 1, 2}}, 1);
+    REQUIRE(!r.ok());  // beyond the item list
+    CHECK(r.error().message.find("item 0: window [0, 2]") != std::string::npos);
+    r = passes.prepare(1024, 1024, DepthFormat::D24, {}, 1);
+    REQUIRE(!r.ok());
+    CHECK(r.error().message.find("target 1024x1024") != std::string::npos);
+    r = passes.prepare(16, 16, DepthFormat::D24, std::vector<raster::WindowedItem>{{{v, good}, 0, 0}, {{v, good}, 1, 1}}, 1);
+    REQUIRE(r.ok());
+    CHECK(r.value() > 0);
+    CHECK(!passes.run(true, one, two).ok());  // a mask of the wrong size
+    auto ok = passes.run(true, two, two);
+    REQUIRE(ok.ok());
+    CHECK(ok.value() == std::vector<std::uint8_t>{0, 1});  // item 1 meets item 0's equal depth: passes
+    // An item prepared as unused: masks that use it are refused; without it, item 1 meets the clear.
+    r = passes.prepare(16, 16, DepthFormat::D24,
+                       std::vector<raster::WindowedItem>{{{v, good}, 0, 0, false}, {{v, good}, 1, 1}}, 1);
+    REQUIRE(r.ok());
+    auto refused = passes.run(true, two, two);
+    REQUIRE(!refused.ok());
+    CHECK(refused.error().message.find("item 0 was prepared as unused") != std::string::npos);
+    const std::vector<std::uint8_t> only1 = {0, 1};
+    ok = passes.run(true, only1, only1);
+    REQUIRE(ok.ok());
+    CHECK(ok.value() == std::vector<std::uint8_t>{0, 0});
+}

@@ -15,7 +15,9 @@
 //  - visibility_pass(size, format, items) answers CULLIDE's two exact-bounds passes of one view
 //    (raster/visibility.h). Every device can: the base class records the two passes and runs them
 //    with clear and execute (recorded_visibility_pass); the emulator answers them natively with
-//    raster::VisibilityPass, the same answers bit for bit at a quarter of the rasterization.
+//    raster::VisibilityPass, the same answers bit for bit at a quarter of the rasterization;
+//  - quick_view(size, format, items, tags) answers Quick-CULLIDE's two exact-bounds passes of one
+//    view the same way: recorded by the base class, natively by the emulator (raster::WindowedPasses).
 // Results must not depend on the thread count (the emulator's are bit-identical for any count).
 #pragma once
 
@@ -68,6 +70,27 @@ class QueryDevice {
     // The two passes recorded as command batches and run with clear and execute.
     [[nodiscard]] Result<std::vector<std::uint8_t>> recorded_visibility_pass(
         ViewSize size, raster::DepthFormat format, std::span<const raster::VisibilityItem> items);
+
+    // Quick-CULLIDE's tags (cullide/quick_cullide.h): apart from every earlier item that is not near
+    // (FFV), from every later one (SFV).
+    static constexpr std::uint8_t kQuickFFV = 1;
+    static constexpr std::uint8_t kQuickSFV = 2;
+    // Quick-CULLIDE's two exact-bounds passes of one view (raster/visibility.h, WindowedPasses) on a
+    // target of `size` and `format`, each on a cleared target: pass 1 forward queries the items
+    // whose tag lacks kQuickFFV and writes those lacking kQuickSFV; an item whose query passes no
+    // sample gains kQuickFFV; then pass 2 backward queries the items lacking kQuickSFV and writes
+    // those lacking kQuickFFV (tags as pass 1 left them); an item whose query passes no sample
+    // gains kQuickSFV. Returns the new tags (one per item; `tags` holds the old ones). Fails as
+    // clear and execute fail, or on invalid items. The default is recorded_quick_view; an override
+    // must give the same tags.
+    [[nodiscard]] virtual Result<std::vector<std::uint8_t>> quick_view(ViewSize size, raster::DepthFormat format,
+                                                                       std::span<const raster::WindowedItem> items,
+                                                                       std::span<const std::uint8_t> tags);
+    // The two passes recorded as command batches (quick_pass_schedule order) and run with clear and
+    // execute.
+    [[nodiscard]] Result<std::vector<std::uint8_t>> recorded_quick_view(ViewSize size, raster::DepthFormat format,
+                                                                        std::span<const raster::WindowedItem> items,
+                                                                        std::span<const std::uint8_t> tags);
 };
 
 // The built-in device: raster::execute on a raster::DepthTarget, on `threads` worker threads

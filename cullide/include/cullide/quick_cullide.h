@@ -64,6 +64,11 @@ struct QuickOptions : VisibilityOptions {
     // box-prefiltered all-pairs test (sweep and prune on item boxes, then triangle boxes, adjacency,
     // exact test): the peer the culling is measured against.
     bool skip_visibility = false;
+    // ExactBounds: answer each view's two passes with the device's quick_view (on the emulator
+    // raster::WindowedPasses: each item rasterized once per view instead of up to four times, the
+    // same tags bit for bit). The statistics still count the queries and triangles of the recorded
+    // passes it replaces. false records and executes the passes (tests compare the two).
+    bool fused_visibility = true;
 };
 
 // The shared figures (visibility.h) read as follows, and Quick-CULLIDE's own:

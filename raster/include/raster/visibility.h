@@ -66,4 +66,59 @@ class VisibilityPass {
     std::unique_ptr<State> s_;
 };
 
+// Quick-CULLIDE's passes (Govindaraju, Knott, Lin, Manocha 2005; cullide/quick_cullide.h) in the
+// exact-bounds mode, each item rasterized once per view instead of up to four times.
+//
+// The recorded form: on a target cleared to 1, a forward pass runs k = 0 .. n-1: the query of item k
+// (exact bounds, GEQUAL against its zmax, mask off, any samples), then the writes (exact bounds,
+// LEQUAL with the zmin, mask on) of every item d whose window [near_lo, near_hi] ends at or before
+// k and that has not been written yet; nothing is written after the last query. The backward pass
+// runs k = n-1 .. 0 the same way with the windows' starts. So the stored depth that the query of
+// item k meets at pixel p is min(clear, zmin at p of every written item d with near_hi[d] < k)
+// forward, near_lo[d] > k backward (LEQUAL writes keep the minimum), and the query passes iff
+// some covered pixel has zmax >= that value.
+//
+// Native: prepare() sets every item's triangles up and keeps, per item and covered pixel, the
+// smallest zmin and the largest zmax of its fragments (the very per-pixel values the recorded draws
+// compute: the same setup, traversal and outward quantization), on any number of threads; run()
+// then replays one pass over those values on one depth array: the same stored depth before every
+// query, so the same answers bit for bit, for any thread count.
+struct WindowedItem {
+    MeshViewD mesh;
+    // The items this one is never tested against (in the recorded form: its writes wait until the
+    // query of item near_hi forward, and of item near_lo backward). Both non-decreasing over the
+    // items, near_lo <= near_hi < the item count.
+    std::uint32_t near_lo = 0, near_hi = 0;
+    // false: no pass run on this preparation queries or writes the item, so it is not rasterized
+    // (Quick-CULLIDE's items proven apart both ways); run() refuses masks that use it.
+    bool used = true;
+};
+
+class WindowedPasses {
+   public:
+    WindowedPasses();
+    ~WindowedPasses();
+    WindowedPasses(const WindowedPasses&) = delete;
+    WindowedPasses& operator=(const WindowedPasses&) = delete;
+
+    // Rasterizes every item once on a width x height target of `format` (exact bounds, full
+    // viewport). The per-pixel record needs width * height <= kMaxWindowedPixels. Fails, naming the
+    // item, position and vertex or window, on invalid input; run() then answers nothing.
+    // threads: workers, 0 = all hardware threads, negative = an error; nothing depends on it.
+    [[nodiscard]] Result<std::size_t> prepare(int width, int height, DepthFormat format,
+                                              std::span<const WindowedItem> items, int threads);
+    // One pass over the prepared items (forward or backward, as above): item k is queried iff
+    // query[k] != 0 and written iff write[k] != 0. Returns per item 1 when it was queried and its
+    // query passed a sample, else 0. Fails when prepare() did not succeed or a mask's size is not
+    // the item count, or a mask uses an item prepared as unused.
+    [[nodiscard]] Result<std::vector<std::uint8_t>> run(bool forward, std::span<const std::uint8_t> query,
+                                                        std::span<const std::uint8_t> write) const;
+
+    static constexpr std::int64_t kMaxWindowedPixels = std::int64_t{512} * 512;
+
+   private:
+    struct State;
+    std::unique_ptr<State> s_;
+};
+
 }  // namespace raster
