@@ -421,6 +421,7 @@ std::vector<TrianglePair> exact_stage(std::span<const Mesh> objects, const std::
     if (o.self)
         for (std::size_t i = 0; i < items.size(); ++i)
             if (items[i].count > 1) pairs.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i), true});
+    const std::size_t self_pairs = pairs.size();
     st.item_pairs = overlapping.size();
     for (const auto& [a, b] : overlapping) {
         const bool is_near = near(items[a], b);
@@ -428,7 +429,10 @@ std::vector<TrianglePair> exact_stage(std::span<const Mesh> objects, const std::
         if (!is_near && ((items[b].tag & kFFV) || (items[a].tag & kSFV))) continue;  // proven apart
         pairs.push_back({a, b, is_near});
     }
-    std::sort(pairs.begin(), pairs.end(), [](const Pair& x, const Pair& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+    // Both runs are sorted by (a, b) already (the self pairs by i; overlapping_sets returns its pairs
+    // sorted, a < b) and no key repeats, so merging them gives the order a full sort gave.
+    std::inplace_merge(pairs.begin(), pairs.begin() + static_cast<std::ptrdiff_t>(self_pairs),
+                       pairs.end(), [](const Pair& x, const Pair& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
     st.item_pairs_kept = pairs.size();
     std::vector<char> counted(items.size(), 0);
     for (const Pair& p : pairs) {
