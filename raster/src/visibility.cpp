@@ -44,9 +44,10 @@ int tile_side(int width, int height) {
 constexpr int kSettleTile = 16;
 constexpr std::uint64_t kSettleMinArea = 16;
 constexpr std::uint32_t kNoObject = 0xffffffffu;
-// The one-tile pass is split between threads (shade_split) only with at least this many triangles
+// The one-tile pass is split between threads (split_pass) only with at least this many triangles
 // per thread: below it a second parallel phase costs more than it saves.
 constexpr std::uint64_t kSplitMinTriangles = 256;
+constexpr std::uint64_t kSplitRunsPerThread = 4;
 
 
 std::string check_vertex(const Double4& d) {
@@ -121,7 +122,7 @@ struct VisibilityPass::State {
     std::vector<std::vector<Fragment>> frags;             // per tile (scratch)
     std::vector<std::vector<std::uint8_t>> need;          // per tile (scratch): per ref, its queries can pass
     std::vector<std::uint32_t> min1, obj1, min2;          // per pixel, tile-major (one tile = side^2)
-    // The split one-tile shade (shade_split): per part, its minima (side^2 each) and fragments.
+    // The split one-tile shade (split_pass): per part, its minima (side^2 each) and fragments.
     std::vector<std::vector<std::uint32_t>> part_min1, part_obj1, part_min2;
     std::vector<std::vector<Fragment>> part_frags;
     std::vector<std::size_t> part_first;  // per part, its first item; part_first[parts] = the item count
@@ -129,6 +130,11 @@ struct VisibilityPass::State {
     // Front end per item (the recorded draws' own setup, so the same polygons). False when some
     // item failed an input check (bad[i]).
     bool front_end(int width, int height, std::span<const VisibilityItem> items, int threads);
+    // Sizes the per-item buffers for n items.
+    void reserve_items(std::size_t n);
+    // One item's triangles set up into tris[i] and pool[i], their pixel-box area into area[i];
+    // false (and bad[i] = 1) when an input check fails.
+    bool setup_item(const detail::FrontEndParams& params, std::span<const VisibilityItem> items, std::size_t i);
     // Each triangle's encoded depth bounds (zq_lo, zq_hi), for settling tiles.
     void depth_bounds(DepthFormat format, std::size_t n_items);
     // Binning, in item order; with one tile and no settling nothing is built (every triangle is in it).
@@ -138,9 +144,15 @@ struct VisibilityPass::State {
     // that may pass against the minimum over the other objects; such items go to hit[].
     void shade(std::span<const VisibilityItem> items, const TileGrid& grid, int width, int height,
                DepthFormat format, std::size_t tile, bool settle);
-    // One tile without settling, on `parts` threads: see shade_split's comment.
-    void shade_split(std::span<const VisibilityItem> items, int side, int width, int height, DepthFormat format,
-                     int parts);
+    // One tile without settling, on `parts` threads, with the front end: see split_pass's comment.
+    // Returns 0 when some item failed an input check, 1 when the split answered (hit[] is set), 2
+    // when the triangles are large enough to settle tiles (the caller goes on with tris[] as set up).
+    int split_pass(std::span<const VisibilityItem> items, int side, int width, int height, DepthFormat format,
+                   int threads, std::size_t parts);
+    // Part `part`'s triangles into its own minima and fragments.
+    void raster_part(std::span<const VisibilityItem> items, int side, int width, int height, DepthFormat format,
+                     std::size_t part);
+    std::vector<std::uint8_t> part_done;  // per part: raster_part ran in the first phase
     // One triangle's fragments into the minima of a tile at (x0, y0)..(x1, y1) of `side` pixels a
     // row; with `keep`, each fragment's zmax goes to `out` for the query test.
     __attribute__((always_inline)) void draw(std::span<const VisibilityItem> items, Ref r, bool keep, int x0, int y0,
@@ -153,49 +165,64 @@ struct VisibilityPass::State {
                         const std::uint32_t* tile_min2);
 };
 
-bool VisibilityPass::State::front_end(int width, int height, std::span<const VisibilityItem> items, int threads) {
-    if (tris.size() < items.size()) {
-        tris.resize(items.size());
-        pool.resize(items.size());
-        bad.resize(items.size());
-        area.resize(items.size());
+void VisibilityPass::State::reserve_items(std::size_t n) {
+    if (tris.size() < n) {
+        tris.resize(n);
+        pool.resize(n);
+        bad.resize(n);
+        area.resize(n);
     }
+}
+
+namespace {
+detail::FrontEndParams front_end_params(int width, int height) {
     detail::FrontEndParams params{};
     params.target_width = width;
     params.target_height = height;
     params.viewport = Viewport{0, 0, width, height};
     params.cull_face = CullFace::None;
     params.front_face = FrontFace::CCW;
-    detail::parallel_for(threads, items.size(), [&](std::size_t i) {
-        auto& item_tris = tris[i];
-        auto& item_pool = pool[i];
-        item_tris.clear();
-        item_pool.clear();
-        const MeshViewD& m = items[i].mesh;
-        item_tris.reserve(m.indices.size() / 3);
-        item_pool.reserve(m.indices.size());
-        bad[i] = 0;
-        area[i] = 0;
-        const std::size_t nv = m.vertices.size();
-        for (std::size_t k = 0; k + 2 < m.indices.size(); k += 3) {
-            const std::uint32_t ia = m.indices[k], ib = m.indices[k + 1], ic = m.indices[k + 2];
-            if (ia >= nv || ib >= nv || ic >= nv) {
-                bad[i] = 1;
-                return;
-            }
-            const Double4 &a = m.vertices[ia], &b = m.vertices[ib], &c = m.vertices[ic];
-            if (!(valid_vertex(a) && valid_vertex(b) && valid_vertex(c))) {
-                bad[i] = 1;
-                return;
-            }
-            const std::size_t before = item_tris.size();
-            detail::setup_bounds_triangle(params, a, b, c, static_cast<std::uint32_t>(i), item_tris, item_pool);
-            if (item_tris.size() != before) {
-                const detail::BoundsTri& t = item_tris.back();
-                area[i] += static_cast<std::uint64_t>(t.x1 - t.x0 + 1) * static_cast<std::uint64_t>(t.y1 - t.y0 + 1);
-            }
+    return params;
+}
+}  // namespace
+
+bool VisibilityPass::State::setup_item(const detail::FrontEndParams& params, std::span<const VisibilityItem> items,
+                                       std::size_t i) {
+    auto& item_tris = tris[i];
+    auto& item_pool = pool[i];
+    item_tris.clear();
+    item_pool.clear();
+    const MeshViewD& m = items[i].mesh;
+    item_tris.reserve(m.indices.size() / 3);
+    item_pool.reserve(m.indices.size());
+    bad[i] = 0;
+    area[i] = 0;
+    const std::size_t nv = m.vertices.size();
+    for (std::size_t k = 0; k + 2 < m.indices.size(); k += 3) {
+        const std::uint32_t ia = m.indices[k], ib = m.indices[k + 1], ic = m.indices[k + 2];
+        if (ia >= nv || ib >= nv || ic >= nv) {
+            bad[i] = 1;
+            return false;
         }
-    });
+        const Double4 &a = m.vertices[ia], &b = m.vertices[ib], &c = m.vertices[ic];
+        if (!(valid_vertex(a) && valid_vertex(b) && valid_vertex(c))) {
+            bad[i] = 1;
+            return false;
+        }
+        const std::size_t before = item_tris.size();
+        detail::setup_bounds_triangle(params, a, b, c, static_cast<std::uint32_t>(i), item_tris, item_pool);
+        if (item_tris.size() != before) {
+            const detail::BoundsTri& t = item_tris.back();
+            area[i] += static_cast<std::uint64_t>(t.x1 - t.x0 + 1) * static_cast<std::uint64_t>(t.y1 - t.y0 + 1);
+        }
+    }
+    return true;
+}
+
+bool VisibilityPass::State::front_end(int width, int height, std::span<const VisibilityItem> items, int threads) {
+    reserve_items(items.size());
+    const detail::FrontEndParams params = front_end_params(width, height);
+    detail::parallel_for(threads, items.size(), [&](std::size_t i) { (void)setup_item(params, items, i); });
     for (std::size_t i = 0; i < items.size(); ++i)
         if (bad[i]) return false;
     return true;
@@ -365,54 +392,68 @@ void VisibilityPass::State::test_fragments(std::span<const VisibilityItem> items
 // The one-tile pass split by items (issue #16: R-CULLIDE's 32^2 views are one tile, so the tile
 // loop gave a second thread nothing). What the pass computes per pixel does not depend on the order
 // of the triangles: the minimum zmin over all objects and over the objects other than the one that
-// holds it. So the items are cut into `parts` runs of about equal pixel area; each run's triangles
-// go into the run's own minima (and its fragments into its own list); the runs' minima are merged
-// pixel by pixel; then each run's fragments are tested against the merged minima. Merging (m1, o1,
-// m2) records keeps their meaning exactly: the smaller m1 wins with its object, and m2 becomes the
-// minimum over the objects other than that one, which from the other record is its m2 if it holds
-// the same object and its m1 otherwise. Every fragment then meets the same value as in the serial
-// pass, so hit[] is the same bit for bit, for any number of parts.
-void VisibilityPass::State::shade_split(std::span<const VisibilityItem> items, const int side, const int width,
-                                        const int height, const DepthFormat format, const int parts) {
-    const auto n_parts = static_cast<std::size_t>(parts);
-    const std::size_t tile_pixels = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
+// holds it. So the items are cut into `parts` runs of about equal triangle counts; each run sets its
+// items up and draws their triangles into the run's own minima (and its fragments into its own
+// list) in one task, so that the set-up triangles are drawn from the cache of the core that made
+// them; the runs' minima are merged pixel by pixel; then each run's fragments are tested against
+// the merged minima. Merging (m1, o1, m2) records keeps their meaning exactly: the smaller m1 wins
+// with its object, and m2 becomes the minimum over the objects other than that one, which from the
+// other record is its m2 if it holds the same object and its m1 otherwise. Every fragment then meets
+// the same value as in the serial pass, so hit[] is the same bit for bit, for any number of parts.
+//
+// Whether the tiles should rather be settled (large triangles) is known only once every item is set
+// up, so a run whose own triangles are large skips its drawing; if the whole pass turns out to
+// settle, the caller takes the settled path with the triangles as set up (any run's drawing is then
+// wasted work, never a different answer), and otherwise the skipped runs are drawn afterwards.
+int VisibilityPass::State::split_pass(std::span<const VisibilityItem> items, const int side, const int width,
+                                      const int height, const DepthFormat format, const int threads,
+                                      const std::size_t n_parts) {
+    reserve_items(items.size());
     if (part_min1.size() < n_parts) {
         part_min1.resize(n_parts);
         part_obj1.resize(n_parts);
         part_min2.resize(n_parts);
         part_frags.resize(n_parts);
     }
-    // Cut by cumulative pixel area (the fill is the cost), at item boundaries: the input decides it.
+    // Cut by triangle count, at item boundaries: the input decides it.
     std::uint64_t total = 0;
-    for (std::size_t i = 0; i < items.size(); ++i) total += area[i];
+    for (const VisibilityItem& it : items) total += it.mesh.indices.size() / 3;
     part_first.assign(n_parts + 1, items.size());
     part_first[0] = 0;
     {
         std::uint64_t sum = 0;
         std::size_t part = 1;
         for (std::size_t i = 0; i < items.size() && part < n_parts; ++i) {
-            // Item i starts part `part` once the items before it hold part/parts of the area.
+            // Item i starts part `part` once the items before it hold part/parts of the triangles.
             while (part < n_parts && sum * n_parts >= total * part) part_first[part++] = i;
-            sum += area[i];
+            sum += items[i].mesh.indices.size() / 3;
         }
     }
-    const std::uint32_t clear = DepthTarget::encode_clear(1.0, format);
-    const int x1 = width - 1, y1 = height - 1;
-    detail::parallel_for(parts, n_parts, [&](std::size_t part) {
-        auto& m1 = part_min1[part];
-        auto& o1 = part_obj1[part];
-        auto& m2 = part_min2[part];
-        m1.assign(tile_pixels, clear);
-        o1.assign(tile_pixels, kNoObject);
-        m2.assign(tile_pixels, clear);
-        auto& out = part_frags[part];
-        out.clear();
-        for (std::size_t i = part_first[part]; i < part_first[part + 1]; ++i)
-            for (std::size_t k = 0; k < tris[i].size(); ++k)
-                draw(items, {static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)}, true, 0, 0, x1, y1, side,
-                     format, m1.data(), o1.data(), m2.data(), out);
+    part_done.assign(n_parts, 0);
+    const detail::FrontEndParams params = front_end_params(width, height);
+    detail::parallel_for(threads, n_parts, [&](std::size_t part) {
+        std::uint64_t part_area = 0, part_count = 0;
+        for (std::size_t i = part_first[part]; i < part_first[part + 1]; ++i) {
+            if (!setup_item(params, items, i)) return;
+            part_area += area[i];
+            part_count += tris[i].size();
+        }
+        if (part_count > 0 && part_area >= kSettleMinArea * part_count) return;  // large: may settle
+        raster_part(items, side, width, height, format, part);
+        part_done[part] = 1;
+    });
+    std::uint64_t area_sum = 0, count = 0;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        if (bad[i]) return 0;
+        area_sum += area[i];
+        count += tris[i].size();
+    }
+    if (count > 0 && area_sum >= kSettleMinArea * count) return 2;
+    detail::parallel_for(threads, n_parts, [&](std::size_t part) {
+        if (!part_done[part]) raster_part(items, side, width, height, format, part);
     });
     // Merge into part 0 (a few thousand pixels: serial).
+    const std::size_t tile_pixels = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
     std::uint32_t* a1 = part_min1[0].data();
     std::uint32_t* ao = part_obj1[0].data();
     std::uint32_t* a2 = part_min2[0].data();
@@ -430,8 +471,28 @@ void VisibilityPass::State::shade_split(std::span<const VisibilityItem> items, c
             }
         }
     }
-    detail::parallel_for(parts, n_parts,
+    hit.assign(items.size(), 0);
+    detail::parallel_for(threads, n_parts,
                          [&](std::size_t part) { test_fragments(items, part_frags[part], a1, ao, a2); });
+    return 1;
+}
+
+void VisibilityPass::State::raster_part(std::span<const VisibilityItem> items, const int side, const int width,
+                                        const int height, const DepthFormat format, const std::size_t part) {
+    const std::size_t tile_pixels = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
+    const std::uint32_t clear = DepthTarget::encode_clear(1.0, format);
+    auto& m1 = part_min1[part];
+    auto& o1 = part_obj1[part];
+    auto& m2 = part_min2[part];
+    m1.assign(tile_pixels, clear);
+    o1.assign(tile_pixels, kNoObject);
+    m2.assign(tile_pixels, clear);
+    auto& out = part_frags[part];
+    out.clear();
+    for (std::size_t i = part_first[part]; i < part_first[part + 1]; ++i)
+        for (std::size_t k = 0; k < tris[i].size(); ++k)
+            draw(items, {static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)}, true, 0, 0, width - 1, height - 1,
+                 side, format, m1.data(), o1.data(), m2.data(), out);
 }
 
 VisibilityPass::VisibilityPass() : s_(std::make_unique<State>()) {}
@@ -453,9 +514,25 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
     for (const VisibilityItem& it : items) counts_ok = counts_ok && it.mesh.indices.size() % 3 == 0;
     if (!counts_ok) return validate(items);
     threads = detail::effective_threads(threads);
-    State& s = *s_;
-    if (!s.front_end(width, height, items, threads)) return validate(items);
     if (items.size() >= kNoObject) return Error{"visibility pass: too many items (limit 2^32 - 1)"};
+    State& s = *s_;
+    // One-tile targets with enough triangles for every thread: the split pass, front end included.
+    std::uint64_t submitted = 0;
+    for (const VisibilityItem& it : items) submitted += it.mesh.indices.size() / 3;
+    const int one_side = tile_side(width, height);
+    const bool one_tile = one_side >= width && one_side >= height;
+    if (one_tile && threads > 1 && submitted >= kSplitMinTriangles * static_cast<std::uint64_t>(threads)) {
+        // A few runs per thread, so that runs of small and of large triangles even out between them.
+        const std::size_t parts = static_cast<std::size_t>(std::min<std::uint64_t>(
+            static_cast<std::uint64_t>(threads) * kSplitRunsPerThread, submitted / kSplitMinTriangles * kSplitRunsPerThread / 2));
+        const int split = s.split_pass(items, one_side, width, height, format, threads, std::max<std::size_t>(parts, 2));
+        if (split == 0) return validate(items);
+        if (split == 1)
+            return std::vector<std::uint8_t>(s.hit.begin(), s.hit.begin() + static_cast<std::ptrdiff_t>(items.size()));
+        // split == 2: large triangles, set up; the settled path below.
+    } else if (!s.front_end(width, height, items, threads)) {
+        return validate(items);
+    }
 
     std::uint64_t area = 0, count = 0;  // of the triangles' pixel boxes
     for (std::size_t i = 0; i < items.size(); ++i) {
@@ -474,12 +551,8 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
         s.min2.resize(pixels);
     }
     s.hit.assign(items.size(), 0);
-    if (grid.count() == 1 && !settle && threads > 1 && count >= kSplitMinTriangles * static_cast<std::uint64_t>(threads)) {
-        s.shade_split(items, side, width, height, format, threads);
-    } else {
-        detail::parallel_for(threads, grid.count(),
-                             [&](std::size_t tile) { s.shade(items, grid, width, height, format, tile, settle); });
-    }
+    detail::parallel_for(threads, grid.count(),
+                         [&](std::size_t tile) { s.shade(items, grid, width, height, format, tile, settle); });
 
     std::vector<std::uint8_t> result(s.hit.begin(), s.hit.begin() + static_cast<std::ptrdiff_t>(items.size()));
     return result;

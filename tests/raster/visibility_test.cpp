@@ -147,7 +147,7 @@ TEST_CASE("The fused visibility pass gives the two recorded passes' answers, any
 TEST_CASE("The fused visibility pass split between threads (one tile, many small triangles) gives the recorded answers") {
     // R-CULLIDE's 32^2 sub-object views: one tile, thousands of triangles of a pixel or two. With
     // more than 256 triangles per thread the pass cuts the items into one run per thread, each with
-    // its own minima, and merges them (visibility.cpp, shade_split). Hundreds of objects, so that the
+    // its own minima, and merges them (visibility.cpp, split_pass). Hundreds of objects, so that the
     // runs' minima hold different objects at the same pixel and the merge decides which one wins;
     // flat triangles at one shared depth make ties between runs.
     test::Rng rng(20261126);
