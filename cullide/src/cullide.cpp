@@ -214,19 +214,23 @@ void record_pass(raster::CommandBatch& batch, std::vector<ObjectGeometry>& g, co
 }
 
 // The queries and triangles of the two passes record_pass would record for `order` (the fused pass
-// reports what it replaces).
+// reports what it replaces): each live item is queried in both passes and written in both except
+// after each pass's last object (order.back() forward, order.front() backward), so with L live
+// items of T triangles in all, 2 L queries and 4 T - T(back) - T(front) triangles.
 void count_passes(const std::vector<ObjectGeometry>& g, const std::vector<std::size_t>& order, ViewStats& vs) {
-    for (int pass = 0; pass < 2; ++pass) {
-        const std::size_t last = pass == 0 ? order.back() : order.front();
-        for (std::size_t i : order) {
-            for (const Item& it : g[i].items) {
-                if (!it.live) continue;
-                ++vs.queries;
-                vs.triangles_rasterized += it.index_count / 3;
-                if (i != last) vs.triangles_rasterized += it.index_count / 3;
-            }
+    const auto live_triangles = [&](std::size_t i) {
+        std::uint64_t t = 0;
+        for (const Item& it : g[i].items) t += it.live ? it.index_count / 3 : 0;
+        return t;
+    };
+    std::uint64_t live = 0, triangles = 0;
+    for (std::size_t i : order)
+        for (const Item& it : g[i].items) {
+            live += it.live ? 1 : 0;
+            triangles += it.live ? it.index_count / 3 : 0;
         }
-    }
+    vs.queries += 2 * live;
+    vs.triangles_rasterized += 4 * triangles - live_triangles(order.back()) - live_triangles(order.front());
 }
 
 // Both passes of one exact-bounds view as the device's visibility pass (query_device.h); prunes
@@ -304,8 +308,14 @@ Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_
     for (int attempt = 0;; ++attempt) {
         Result<raster::OrthoView> view = make_view(axis, bounds, extra_depth, size, o.depth_format);
         if (!view) return view.error();
-        for (std::size_t i : order)
-            if (Status s = prepare_geometry(g[i], stage, view.value(), o.mode, o.gpu_rules); !s) return s;
+        // One object per parallel job (each writes only its own geometry); the first failure in
+        // order is reported.
+        std::vector<Status> prepared(order.size());
+        detail::parallel_chunks(o.threads, order.size(), [&](std::size_t k) {
+            prepared[k] = prepare_geometry(g[order[k]], stage, view.value(), o.mode, o.gpu_rules);
+        });
+        for (const Status& s : prepared)
+            if (!s) return s;
         if (o.mode != VisibilityMode::Offset) return Status{};
         double overshoot = 0.0;  // in clip units beyond [-1, 1]
         for (std::size_t i : order)
@@ -443,10 +453,13 @@ std::vector<ObjectGeometry> object_geometry(std::span<const Mesh> objects, std::
 // (neighbours in meshes stored strip- or patch-wise; see docs/cullide.md for what this choice costs
 // on scrambled meshes), with its triangles' boxes for the exact stage.
 std::vector<ObjectGeometry> subobject_geometry(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
-                                               std::vector<ObjectGeometry>&& whole, std::size_t group) {
+                                               std::vector<ObjectGeometry>&& whole, std::size_t group, int threads) {
     std::vector<ObjectGeometry> subs;
-    for (ObjectGeometry& og : whole) {
-        if (!og.items[0].live) continue;
+    for (ObjectGeometry& og : whole)
+        if (og.items[0].live) subs.push_back(std::move(og));
+    // One object per parallel job: each fills only its own geometry.
+    detail::parallel_chunks(threads, subs.size(), [&](std::size_t k) {
+        ObjectGeometry& og = subs[k];
         const Mesh& m = objects[active[og.active_index]];
         og.items.clear();
         og.triangle_boxes.resize(m.triangles.size());
@@ -458,8 +471,7 @@ std::vector<ObjectGeometry> subobject_geometry(std::span<const Mesh> objects, st
             og.items.push_back(
                 {static_cast<std::uint32_t>(first * 3), static_cast<std::uint32_t>((last - first) * 3), b, true, {}});
         }
-        subs.push_back(std::move(og));
-    }
+    });
     return subs;
 }
 
@@ -491,7 +503,8 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
 
     t0 = Clock::now();
     std::vector<ObjectGeometry> subs =
-        subobject_geometry(objects, active, std::move(whole), static_cast<std::size_t>(options.subobject_triangles));
+        subobject_geometry(objects, active, std::move(whole), static_cast<std::size_t>(options.subobject_triangles),
+                           options.threads);
     for (const ObjectGeometry& og : subs) st.subobjects += og.items.size();
     if (Status s = run_stage(subs, CullStage::SubObjects, options, size, device, st); !s) return s.error();
     st.pcs_subobjects = count_live(subs);
