@@ -898,16 +898,28 @@ void sort_along(std::vector<SweepRef>& refs, int axis) {
 }
 
 std::vector<std::pair<std::uint32_t, std::uint32_t>> overlapping_sets(std::vector<SweepRef> refs, int threads) {
+    std::uint64_t overlapping = 0;
+    return overlapping_sets(std::move(refs), threads, nullptr, overlapping);
+}
+
+std::vector<std::pair<std::uint32_t, std::uint32_t>> overlapping_sets(
+    std::vector<SweepRef> refs, int threads, const std::function<bool(std::uint32_t, std::uint32_t)>& keep,
+    std::uint64_t& overlapping) {
     const int axis = spread_axis(refs);
     sort_along(refs, axis);
     const std::size_t units = (refs.size() + kSweepChunk - 1) / kSweepChunk;
     std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> found(units);
+    std::vector<std::uint64_t> seen(units, 0);
     parallel_chunks(threads, units, [&](std::size_t u) {
         sweep_overlaps(refs, axis, u * kSweepChunk, std::min(refs.size(), (u + 1) * kSweepChunk), true,
                        [&](const SweepRef& a, const SweepRef& b) {
-                           found[u].emplace_back(std::min(a.set, b.set), std::max(a.set, b.set));
+                           ++seen[u];
+                           const std::uint32_t lo = std::min(a.set, b.set), hi = std::max(a.set, b.set);
+                           if (!keep || keep(lo, hi)) found[u].emplace_back(lo, hi);
                        });
     });
+    overlapping = 0;
+    for (std::uint64_t n : seen) overlapping += n;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
     for (const auto& f : found) out.insert(out.end(), f.begin(), f.end());
     std::sort(out.begin(), out.end());

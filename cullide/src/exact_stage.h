@@ -18,6 +18,7 @@
 #include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <span>
 #include <utility>
@@ -71,6 +72,11 @@ void sweep_overlaps(std::span<const SweepRef> refs, int axis, std::size_t begin,
 // sorted here, along its spread axis.
 [[nodiscard]] std::vector<std::pair<std::uint32_t, std::uint32_t>> overlapping_sets(std::vector<SweepRef> refs,
                                                                                     int threads);
+// The same pairs, only those keep(a, b) accepts (a < b; keep is called concurrently), with
+// `overlapping` set to how many pairs overlap in all (kept or not).
+[[nodiscard]] std::vector<std::pair<std::uint32_t, std::uint32_t>> overlapping_sets(
+    std::vector<SweepRef> refs, int threads, const std::function<bool(std::uint32_t, std::uint32_t)>& keep,
+    std::uint64_t& overlapping);
 
 // A box in floats rounded outward (it holds the double box it was made from): a cheap, never-missing
 // filter; float_overlaps(a, b) false means the double boxes are disjoint too.

@@ -388,14 +388,12 @@ bool near(const Item& a, std::size_t b) { return b >= a.near_lo && b <= a.near_h
 
 using ItemPair = std::pair<std::uint32_t, std::uint32_t>;
 
-// Item pairs (a < b) whose boxes overlap, by sweep and prune (exact_stage.h); BFV items only when
-// `with_bfv`. Sorted.
-std::vector<ItemPair> box_pairs(const std::vector<Item>& items, bool with_bfv, int threads) {
+// Item pairs (a < b) whose boxes overlap, BFV items included, by sweep and prune (exact_stage.h).
+// Sorted.
+std::vector<ItemPair> box_pairs(const std::vector<Item>& items, int threads) {
     std::vector<detail::SweepRef> refs;
-    for (std::size_t i = 0; i < items.size(); ++i) {
-        if (items[i].tag == kBFV && !with_bfv) continue;
+    for (std::size_t i = 0; i < items.size(); ++i)
         refs.push_back({items[i].box, items[i].geom, static_cast<std::uint32_t>(i), detail::kWholeSet});
-    }
     return detail::overlapping_sets(std::move(refs), threads);
 }
 
@@ -422,7 +420,7 @@ std::vector<TrianglePair> exact_stage(std::span<const Mesh> objects, const std::
         for (std::size_t i = 0; i < items.size(); ++i)
             if (items[i].count > 1) pairs.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(i), true});
     const std::size_t self_pairs = pairs.size();
-    st.item_pairs = overlapping.size();
+    if (o.self) st.item_pairs = overlapping.size();  // (without self: counted by the sweep, which filtered)
     for (const auto& [a, b] : overlapping) {
         const bool is_near = near(items[a], b);
         if (is_near && !o.self) continue;  // pieces of one object (no self-collision)
@@ -563,7 +561,7 @@ Status self_stage(std::span<const Mesh> objects, std::span<const std::uint32_t> 
     st.subobjects = items.size();
     // Box pairs once (they include BFV items: their near pairs stay open); the box tags leave
     // to the passes only the items with a far overlapping box.
-    overlapping = box_pairs(items, true, options.threads);
+    overlapping = box_pairs(items, options.threads);
     if (!options.skip_visibility) box_tags(items, overlapping);
     st.pcs_boxes = count_live(items);
     if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, size, device, st); !s) return s;
@@ -593,7 +591,21 @@ Result<std::vector<TrianglePair>> quick_cullide_pairs(std::span<const Mesh> obje
     if (!ran) return ran.error();
 
     auto t0 = Clock::now();
-    if (!options.self) overlapping = box_pairs(items, false, options.threads);
+    if (!options.self) {
+        // Without self-collision the exact stage drops the pairs of one object's items and those the
+        // tags prove apart (exact_stage's own filter): the sweep drops them as it meets them, and
+        // counts every overlapping pair for item_pairs.
+        std::vector<detail::SweepRef> refs;
+        for (std::size_t i = 0; i < items.size(); ++i)
+            if (items[i].tag != kBFV)
+                refs.push_back({items[i].box, items[i].geom, static_cast<std::uint32_t>(i), detail::kWholeSet});
+        overlapping = detail::overlapping_sets(
+            std::move(refs), options.threads,
+            [&](std::uint32_t a, std::uint32_t b) {
+                return !near(items[a], b) && !(items[b].tag & kFFV) && !(items[a].tag & kSFV);
+            },
+            st.item_pairs);
+    }
     std::vector<TrianglePair> pairs = exact_stage(objects, geoms, items, overlapping, options, st);
     st.exact_ms = ms_since(t0);
     if (stats != nullptr) *stats = std::move(st);
