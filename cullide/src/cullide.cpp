@@ -130,16 +130,13 @@ Status prepare_geometry(ObjectGeometry& og, CullStage stage, const raster::Ortho
         og.offset = std::move(m).value();
         return Status{};
     }
-    raster::Result<std::vector<raster::Double4>> c = raster::ortho_view_to_clip(view, og.positions);
+    raster::Result<std::size_t> c = raster::ortho_view_to_clip(view, og.positions, og.clip_d);
     if (!c) return Error{"view transform: " + c.error().message};
-    if (mode == VisibilityMode::ExactBounds) {
-        og.clip_d = std::move(c).value();
-        return Status{};
-    }
+    if (mode == VisibilityMode::ExactBounds) return Status{};
     // GL-exact: one rounding to nearest float per coordinate; the same floats go to any device.
-    og.clip.resize(c.value().size());
+    og.clip.resize(og.clip_d.size());
     for (std::size_t i = 0; i < og.clip.size(); ++i) {
-        const raster::Double4& d = c.value()[i];
+        const raster::Double4& d = og.clip_d[i];
         og.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), detail::gl_exact_clip_depth(d.z, rules), 1.0f};
     }
     return Status{};

@@ -102,18 +102,15 @@ Status transform_geoms(std::vector<Geom>& geoms, const std::vector<char>& geom_l
     std::vector<std::string> errors(live.size());
     detail::parallel_chunks(threads, live.size(), [&](std::size_t j) {
         Geom& g = geoms[live[j]];
-        raster::Result<std::vector<raster::Double4>> c = raster::ortho_view_to_clip(view, g.positions);
+        raster::Result<std::size_t> c = raster::ortho_view_to_clip(view, g.positions, g.clip_d);
         if (!c) {
             errors[j] = "view transform: " + c.error().message;
             return;
         }
-        if (mode == VisibilityMode::ExactBounds) {
-            g.clip_d = std::move(c).value();
-            return;
-        }
-        g.clip.resize(c.value().size());
+        if (mode == VisibilityMode::ExactBounds) return;
+        g.clip.resize(g.clip_d.size());
         for (std::size_t i = 0; i < g.clip.size(); ++i) {
-            const raster::Double4& d = c.value()[i];
+            const raster::Double4& d = g.clip_d[i];
             g.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), detail::gl_exact_clip_depth(d.z, rules), 1.0f};
         }
     });

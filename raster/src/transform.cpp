@@ -123,27 +123,33 @@ Double3 view_axes(const OrthoView& view, Double3 world) {
     return Double3{axis_of(world, u), axis_of(world, v), axis_of(world, d)};
 }
 
-Result<std::vector<Double4>> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points) {
+Result<std::size_t> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points,
+                                       std::vector<Double4>& out) {
     const Double3 lo = view_axes(view, view.box_min);
     const Double3 hi = view_axes(view, view.box_max);
     Double3 scale;
     for (int k = 0; k < 3; ++k) axis_ref(scale, k) = 2.0 / (axis_of(hi, k) - axis_of(lo, k));
-    std::vector<Double4> out;
-    out.reserve(points.size());
+    out.resize(points.size());
     for (std::size_t i = 0; i < points.size(); ++i) {
         const Double3& p = points[i];
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
             return Error{"ortho_view_to_clip: point " + std::to_string(i) + " is not finite"};
         const Double3 a = view_axes(view, p);
-        Double4 c;
+        Double4& c = out[i];
         c.x = (a.x - lo.x) * scale.x - 1.0;
         c.y = (a.y - lo.y) * scale.y - 1.0;
         c.z = (a.z - lo.z) * scale.z - 1.0;
         c.w = 1.0;
         if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z))
             return Error{"ortho_view_to_clip: point " + std::to_string(i) + " overflows the double range in clip space"};
-        out.push_back(c);
     }
+    return points.size();
+}
+
+Result<std::vector<Double4>> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points) {
+    std::vector<Double4> out;
+    Result<std::size_t> r = ortho_view_to_clip(view, points, out);
+    if (!r) return r.error();
     return out;
 }
 

@@ -118,6 +118,16 @@ TEST_CASE("The orthographic view helper maps the box to [-1, 1] within its docum
         const auto pts = random_points(rng, v, 4);
         auto c = raster::ortho_view_to_clip(v, pts);
         REQUIRE(c.ok());
+        // The overload into a caller's vector (longer than needed, holding old values) gives the
+        // same bits and the point count.
+        std::vector<raster::Double4> reused(pts.size() + 3, raster::Double4{7, 7, 7, 7});
+        auto n = raster::ortho_view_to_clip(v, pts, reused);
+        REQUIRE(n.ok());
+        CHECK(n.value() == pts.size());
+        REQUIRE(reused.size() == pts.size());
+        for (std::size_t i = 0; i < pts.size(); ++i)
+            CHECK((reused[i].x == c.value()[i].x && reused[i].y == c.value()[i].y && reused[i].z == c.value()[i].z &&
+                   reused[i].w == c.value()[i].w));
         for (std::size_t i = 0; i < pts.size(); ++i) {
             const Double3 a = raster::view_axes(v, pts[i]);
             const double got[3] = {c.value()[i].x, c.value()[i].y, c.value()[i].z};

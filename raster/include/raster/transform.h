@@ -79,6 +79,10 @@ void view_axis_indices(Axis axis, int& u, int& v, int& d);
 // docs/reliable-raster.md), so the composition stays conservative. Fails on a non-finite point or
 // result (naming the index).
 [[nodiscard]] Result<std::vector<Double4>> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points);
+// The same into `out` (resized to the point count; its storage is reused, so a caller transforming
+// the same geometry view after view allocates only while it grows). On failure `out` is unspecified.
+[[nodiscard]] Result<std::size_t> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points,
+                                                     std::vector<Double4>& out);
 
 // The view's cell in world units: dx, dy = one pixel along u, v; dz = one depth quantum along d
 // (D16: 1/65535, D24: 1/16777215, D32F: 2^-24, the largest float spacing in [0.5, 1]) times the
