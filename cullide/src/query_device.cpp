@@ -9,6 +9,22 @@
 #include "cullide_detail.h"
 
 namespace cullide {
+namespace {
+
+// The recorded passes' draw states: queries GEQUAL with the depth mask off, writes LEQUAL with it
+// on, both in the exact-bounds mode.
+std::pair<raster::DrawState, raster::DrawState> exact_bounds_states() {
+    raster::DrawState query_state;
+    query_state.mode = raster::RasterMode::ExactBounds;
+    query_state.depth_func = raster::DepthFunc::GEqual;
+    query_state.depth_write = false;
+    raster::DrawState write_state = query_state;
+    write_state.depth_func = raster::DepthFunc::LEqual;
+    write_state.depth_write = true;
+    return {query_state, write_state};
+}
+
+}  // namespace
 
 Result<std::vector<std::uint8_t>> QueryDevice::visibility_pass(ViewSize size, raster::DepthFormat format,
                                                                std::span<const raster::VisibilityItem> items) {
@@ -39,13 +55,7 @@ Result<std::vector<std::uint8_t>> QueryDevice::recorded_visibility_pass(
         objects.emplace_back(b, e);
         b = e;
     }
-    raster::DrawState query_state;
-    query_state.mode = raster::RasterMode::ExactBounds;
-    query_state.depth_func = raster::DepthFunc::GEqual;
-    query_state.depth_write = false;
-    raster::DrawState write_state = query_state;
-    write_state.depth_func = raster::DepthFunc::LEqual;
-    write_state.depth_write = true;
+    const auto [query_state, write_state] = exact_bounds_states();
 
     // Both passes recorded, then run with execute_cleared (each on a cleared target).
     std::array<raster::CommandBatch, 2> batches = {raster::CommandBatch(size.width(), size.height()),
@@ -93,13 +103,7 @@ Result<std::vector<std::uint8_t>> QueryDevice::recorded_quick_view(ViewSize size
     if (tags.size() != items.size())
         return Error{name() + ": quick_view: " + std::to_string(tags.size()) + " tags for " +
                      std::to_string(items.size()) + " items"};
-    raster::DrawState query_state;
-    query_state.mode = raster::RasterMode::ExactBounds;
-    query_state.depth_func = raster::DepthFunc::GEqual;
-    query_state.depth_write = false;
-    raster::DrawState write_state = query_state;
-    write_state.depth_func = raster::DepthFunc::LEqual;
-    write_state.depth_write = true;
+    const auto [query_state, write_state] = exact_bounds_states();
     std::vector<std::uint8_t> out(tags.begin(), tags.end());
     std::vector<std::uint32_t> query(items.size());
     for (const bool forward : {true, false}) {  // pass 2 reads the tags pass 1 left

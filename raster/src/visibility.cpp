@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "exact_bounds.h"
@@ -100,6 +101,16 @@ Error validate(std::span<const VisibilityItem> items) {
         }
     }
     return Error{"visibility pass: invalid input"};  // not reached: some check above fails
+}
+
+// The depth format and thread count checks of both passes' entry points, naming `what`.
+std::optional<Error> check_format_threads(const char* what, DepthFormat format, int threads) {
+    if (format != DepthFormat::D16 && format != DepthFormat::D24 && format != DepthFormat::D32F)
+        return Error{std::string(what) + ": invalid depth format"};
+    if (threads < 0)
+        return Error{std::string(what) + ": threads = " + std::to_string(threads) +
+                     " is out of range: it must be >= 0 (0 = all hardware threads)"};
+    return std::nullopt;
 }
 
 // The target cut into square tiles of `side` pixels, row-major.
@@ -503,11 +514,7 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
     if (width < 1 || height < 1 || width > kMaxTargetSize || height > kMaxTargetSize)
         return Error{"visibility pass: target " + std::to_string(width) + "x" + std::to_string(height) +
                      " is outside 1.." + std::to_string(kMaxTargetSize) + " per side"};
-    if (format != DepthFormat::D16 && format != DepthFormat::D24 && format != DepthFormat::D32F)
-        return Error{"visibility pass: invalid depth format"};
-    if (threads < 0)
-        return Error{"visibility pass: threads = " + std::to_string(threads) +
-                     " is out of range: it must be >= 0 (0 = all hardware threads)"};
+    if (std::optional<Error> e = check_format_threads("visibility pass", format, threads)) return *e;
     // Every index and vertex is checked in the front end, next to its use; only when some check
     // fails does `validate` run, to return the first error in item and index order.
     bool counts_ok = true;
@@ -616,11 +623,7 @@ Result<std::size_t> WindowedPasses::prepare(int width, int height, DepthFormat f
     if (width < 1 || height < 1 || static_cast<std::int64_t>(width) * height > kMaxWindowedPixels)
         return Error{"windowed passes: target " + std::to_string(width) + "x" + std::to_string(height) +
                      " is outside 1.." + std::to_string(kMaxWindowedPixels) + " pixels"};
-    if (format != DepthFormat::D16 && format != DepthFormat::D24 && format != DepthFormat::D32F)
-        return Error{"windowed passes: invalid depth format"};
-    if (threads < 0)
-        return Error{"windowed passes: threads = " + std::to_string(threads) +
-                     " is out of range: it must be >= 0 (0 = all hardware threads)"};
+    if (std::optional<Error> e = check_format_threads("windowed passes", format, threads)) return *e;
     if (items.size() >= kNoObject) return Error{"windowed passes: too many items (limit 2^32 - 2)"};
     const std::size_t n = items.size();
     for (std::size_t i = 0; i < n; ++i) {
