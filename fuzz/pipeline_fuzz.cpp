@@ -7,9 +7,10 @@
 // default stage rules or the published ones (object stage on, stop when nothing more is pruned).
 // Property (R-CULLIDE's guarantee, Govindaraju et al., "Fast reliable collision culling using
 // graphics hardware", 2004): the culling never drops a colliding pair and the exact stage removes
-// every false positive, so process_frame with rcullide and rcullide-offset returns exactly the
-// pairs of exact_pairs. Invalid scenes (a bad index or a non-finite coordinate, injected on purpose
-// now and then) must be rejected by both or by neither. Any violation prints the scene and aborts.
+// every false positive, so process_frame with rcullide, rcullide-offset and qcullide returns exactly
+// the pairs of exact_pairs (qcullide with self-collision: those of exact_pairs with self). Invalid
+// scenes (a bad index or a non-finite coordinate, injected on purpose now and then) must be rejected
+// by both or by neither. Any violation prints the scene and aborts.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -125,9 +126,9 @@ void print_scene(const std::vector<Mesh>& scene) {
 
 [[noreturn]] void fail(const std::vector<Mesh>& scene, const cullide::RunOptions& opt, const std::string& what) {
     std::fprintf(stderr,
-                 "pipeline_fuzz: property violated (%s, resolution %d, %s, subobject %d, rounds %d, min_prune %g, "
+                 "pipeline_fuzz: property violated (%s%s, resolution %d, %s, subobject %d, rounds %d, min_prune %g, "
                  "object stage %s, %s): %s\n",
-                 cullide::to_string(opt.method), opt.resolution, cullide::to_string(opt.depth_format),
+                 cullide::to_string(opt.method), opt.self ? " --self" : "", opt.resolution, cullide::to_string(opt.depth_format),
                  opt.subobject_triangles, opt.max_rounds, opt.min_prune,
                  opt.object_stage == cullide::ObjectStage::On ? "on" : "auto", cullide::to_string(opt.broadphase),
                  what.c_str());
@@ -161,9 +162,22 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
     cullide::ExactOptions exact_opt;
     exact_opt.threads = 1;
-    const cullide::Result<std::vector<cullide::TrianglePair>> want = cullide::exact_pairs(scene, exact_opt);
-    for (const cullide::Method method : {cullide::Method::RCullide, cullide::Method::RCullideOffset}) {
+    const cullide::Result<std::vector<cullide::TrianglePair>> want_apart = cullide::exact_pairs(scene, exact_opt);
+    exact_opt.self = true;
+    const cullide::Result<std::vector<cullide::TrianglePair>> want_self = cullide::exact_pairs(scene, exact_opt);
+    // Quick-CULLIDE (exact bounds) too, without and with self-collision: its views answer through
+    // raster::WindowedPasses (each item rasterized once per view), which must keep the same
+    // guarantee. (It takes no object-stage or min-prune options: they are CULLIDE's.)
+    struct Run {
+        cullide::Method method;
+        bool self;
+    };
+    for (const Run run : {Run{cullide::Method::RCullide, false}, Run{cullide::Method::RCullideOffset, false},
+                          Run{cullide::Method::QCullide, false}, Run{cullide::Method::QCullide, true}}) {
+        const cullide::Method method = run.method;
         opt.method = method;
+        opt.self = run.self;
+        const cullide::Result<std::vector<cullide::TrianglePair>>& want = run.self ? want_self : want_apart;
         // One context for the whole run: a frame's results never depend on what ran through it
         // before (tests/cullide/frame_context_test.cpp), and it spares each input the device and
         // depth-buffer set-up (cullide/pipeline.h).

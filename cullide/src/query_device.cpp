@@ -55,7 +55,9 @@ Result<std::vector<std::uint8_t>> QueryDevice::recorded_visibility_pass(
         objects.emplace_back(b, e);
         b = e;
     }
-    const auto [query_state, write_state] = exact_bounds_states();
+    const std::pair<raster::DrawState, raster::DrawState> states = exact_bounds_states();
+    const raster::DrawState& query_state = states.first;
+    const raster::DrawState& write_state = states.second;
 
     // Both passes recorded, then run with execute_cleared (each on a cleared target).
     std::array<raster::CommandBatch, 2> batches = {raster::CommandBatch(size.width(), size.height()),
@@ -103,7 +105,9 @@ Result<std::vector<std::uint8_t>> QueryDevice::recorded_quick_view(ViewSize size
     if (tags.size() != items.size())
         return Error{name() + ": quick_view: " + std::to_string(tags.size()) + " tags for " +
                      std::to_string(items.size()) + " items"};
-    const auto [query_state, write_state] = exact_bounds_states();
+    const std::pair<raster::DrawState, raster::DrawState> states = exact_bounds_states();
+    const raster::DrawState& query_state = states.first;
+    const raster::DrawState& write_state = states.second;
     std::vector<std::uint8_t> out(tags.begin(), tags.end());
     std::vector<std::uint32_t> query(items.size());
     for (const bool forward : {true, false}) {  // pass 2 reads the tags pass 1 left
