@@ -309,8 +309,9 @@ namespace {
 // with self-collision), or a mix of both shapes across the list.
 void random_windows(test::Rng& rng, std::size_t n, std::vector<std::uint32_t>& lo, std::vector<std::uint32_t>& hi,
                     const std::vector<std::uint32_t>& object) {
-    lo.resize(n);
-    hi.resize(n);
+    // (assign, not resize: GCC 12 at -O3 reports a null dereference in resize on an empty vector)
+    lo.assign(n, 0);
+    hi.assign(n, 0);
     const int shape = static_cast<int>(rng.below(3));
     const auto w = static_cast<std::uint32_t>(rng.below(4));
     for (std::size_t i = 0; i < n; ++i) {
