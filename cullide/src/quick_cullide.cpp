@@ -385,13 +385,18 @@ bool near(const Item& a, std::size_t b) { return b >= a.near_lo && b <= a.near_h
 
 using ItemPair = std::pair<std::uint32_t, std::uint32_t>;
 
-// Item pairs (a < b) whose boxes overlap, BFV items included, by sweep and prune (exact_stage.h).
-// Sorted.
-std::vector<ItemPair> box_pairs(const std::vector<Item>& items, int threads) {
+// The items' boxes for the sweep and prune (exact_stage.h), BFV items only when `with_bfv`.
+std::vector<detail::SweepRef> item_refs(const std::vector<Item>& items, bool with_bfv) {
     std::vector<detail::SweepRef> refs;
     for (std::size_t i = 0; i < items.size(); ++i)
-        refs.push_back({items[i].box, items[i].geom, static_cast<std::uint32_t>(i), detail::kWholeSet});
-    return detail::overlapping_sets(std::move(refs), threads);
+        if (with_bfv || items[i].tag != kBFV)
+            refs.push_back({items[i].box, items[i].geom, static_cast<std::uint32_t>(i), detail::kWholeSet});
+    return refs;
+}
+
+// Item pairs (a < b) whose boxes overlap, BFV items included. Sorted.
+std::vector<ItemPair> box_pairs(const std::vector<Item>& items, int threads) {
+    return detail::overlapping_sets(item_refs(items, true), threads);
 }
 
 // Self-collision box classification (ours, before the visibility passes): an item whose box meets
@@ -592,12 +597,8 @@ Result<std::vector<TrianglePair>> quick_cullide_pairs(std::span<const Mesh> obje
         // Without self-collision the exact stage drops the pairs of one object's items and those the
         // tags prove apart (exact_stage's own filter): the sweep drops them as it meets them, and
         // counts every overlapping pair for item_pairs.
-        std::vector<detail::SweepRef> refs;
-        for (std::size_t i = 0; i < items.size(); ++i)
-            if (items[i].tag != kBFV)
-                refs.push_back({items[i].box, items[i].geom, static_cast<std::uint32_t>(i), detail::kWholeSet});
         overlapping = detail::overlapping_sets(
-            std::move(refs), options.threads,
+            item_refs(items, false), options.threads,
             [&](std::uint32_t a, std::uint32_t b) {
                 return !near(items[a], b) && !(items[b].tag & kFFV) && !(items[a].tag & kSFV);
             },

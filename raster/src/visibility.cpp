@@ -80,27 +80,32 @@ bool valid_vertex(const Double4& d) {
            std::fabs(d.z) <= kMaxExactBoundsCoordinate;  // false for NaN too
 }
 
-// The input checks, in item and index order: the first failure's message (called only when the
-// front end found a failure, or an index count is not a multiple of 3).
-Error validate(std::span<const VisibilityItem> items) {
-    for (std::size_t i = 0; i < items.size(); ++i) {
-        const MeshViewD& m = items[i].mesh;
+// The input checks, in item and index order: the first failure's message, prefixed by `what`
+// (called only when the front end found a failure, or an index count is not a multiple of 3).
+// mesh_of(i) is item i's MeshViewD.
+template <class MeshOf>
+Error validate(const char* what, std::size_t n, MeshOf&& mesh_of) {
+    for (std::size_t i = 0; i < n; ++i) {
+        const MeshViewD& m = mesh_of(i);
         if (m.indices.size() % 3 != 0)
-            return Error{"visibility pass: item " + std::to_string(i) + ": index count " +
+            return Error{std::string(what) + ": item " + std::to_string(i) + ": index count " +
                          std::to_string(m.indices.size()) + " is not a multiple of 3"};
         for (std::size_t k = 0; k < m.indices.size(); ++k) {
             if (m.indices[k] >= m.vertices.size())
-                return Error{"visibility pass: item " + std::to_string(i) + ": index " + std::to_string(m.indices[k]) +
-                             " at position " + std::to_string(k) + " is beyond the vertex list (size " +
-                             std::to_string(m.vertices.size()) + ")"};
+                return Error{std::string(what) + ": item " + std::to_string(i) + ": index " +
+                             std::to_string(m.indices[k]) + " at position " + std::to_string(k) +
+                             " is beyond the vertex list (size " + std::to_string(m.vertices.size()) + ")"};
             const Double4& d = m.vertices[m.indices[k]];
             if (valid_vertex(d)) continue;
             if (std::string why = check_vertex(d); !why.empty())
-                return Error{"visibility pass: item " + std::to_string(i) + ": vertex " +
+                return Error{std::string(what) + ": item " + std::to_string(i) + ": vertex " +
                              std::to_string(m.indices[k]) + " " + why};
         }
     }
-    return Error{"visibility pass: invalid input"};  // not reached: some check above fails
+    return Error{std::string(what) + ": invalid input"};  // not reached: some check above fails
+}
+Error validate(std::span<const VisibilityItem> items) {
+    return validate("visibility pass", items.size(), [&](std::size_t i) -> const MeshViewD& { return items[i].mesh; });
 }
 
 // The depth format and thread count checks of both passes' entry points, naming `what`.
@@ -660,12 +665,7 @@ Result<std::size_t> WindowedPasses::prepare(int width, int height, DepthFormat f
         1, std::min<std::uint64_t>(static_cast<std::uint64_t>(threads) * 4, triangles / kChunkMinTriangles));
     const auto n_chunks = static_cast<std::size_t>(n_chunks64);
     if (s.chunks.size() < n_chunks) s.chunks.resize(n_chunks);
-    detail::FrontEndParams params{};
-    params.target_width = width;
-    params.target_height = height;
-    params.viewport = Viewport{0, 0, width, height};
-    params.cull_face = CullFace::None;
-    params.front_face = FrontFace::CCW;
+    const detail::FrontEndParams params = front_end_params(width, height);
     detail::parallel_for(threads, n_chunks, [&](std::size_t c) {
         State::Chunk& ch = s.chunks[c];
         ch.records.clear();
@@ -736,11 +736,7 @@ Result<std::size_t> WindowedPasses::prepare(int width, int height, DepthFormat f
     });
     for (std::size_t i = 0; i < n; ++i) {
         if (!s.bad[i]) continue;
-        std::vector<VisibilityItem> as_items(n);
-        for (std::size_t j = 0; j < n; ++j) as_items[j].mesh = items[j].mesh;
-        Error e = validate(as_items);
-        e.message.replace(0, std::string("visibility pass").size(), "windowed passes");
-        return e;
+        return validate("windowed passes", n, [&](std::size_t j) -> const MeshViewD& { return items[j].mesh; });
     }
     // Every item's spans, in item order (the chunks' segments are in item order, chunk after chunk).
     s.spans.clear();
