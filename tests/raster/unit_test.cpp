@@ -234,6 +234,35 @@ TEST_CASE("next_down / next_up (float_step.h) equal std::nextafter on every expo
     CHECK(differ == 0);
 }
 
+TEST_CASE("lrint32 (float_step.h) equals std::lrint below 2^31, ties and the default rounding mode included") {
+    raster_test::SplitMix64 rng(0x1a1bu);
+    std::vector<float> values = {0.0f, -0.0f, 0.5f, -0.5f, 1.5f, -1.5f, 2.5f, -2.5f, 0.49999997f, -0.49999997f,
+                                 0x1p30f, -0x1p30f, 2147483520.0f, -2147483648.0f,
+                                 std::numeric_limits<float>::denorm_min()};
+    // Every exponent below 2^31, random mantissas, and the halfway points of the exponents where
+    // floats still have a fraction (the ties of round half to even).
+    for (std::uint32_t exponent = 0; exponent < 127 + 31; ++exponent) {
+        for (int k = 0; k < 2000; ++k) {
+            const std::uint32_t mantissa = static_cast<std::uint32_t>(rng.next()) & 0x7fffffu;
+            values.push_back(std::bit_cast<float>((exponent << 23) | mantissa | (k % 2 == 0 ? 0u : 0x80000000u)));
+        }
+    }
+    for (int i = -5000; i <= 5000; ++i) values.push_back(static_cast<float>(i) + 0.5f);
+    std::size_t differ = 0;
+    float first_bad = 0.0f;
+    for (const float f : values) {
+        if (raster::detail::lrint32(f) != std::lrint(f)) {
+            if (differ == 0) first_bad = f;
+            ++differ;
+        }
+    }
+    CHECK(values.size() > 300000);
+    CHECK(raster::detail::lrint32(2.5f) == 2);   // half to even, not away from zero
+    CHECK(raster::detail::lrint32(-3.5f) == -4);
+    CAPTURE(first_bad);
+    CHECK(differ == 0);
+}
+
 TEST_CASE("Two triangles sharing a diagonal cover a pixel-aligned square exactly once") {
     // Square [2, 10] x [3, 11] in pixels: centres x + 0.5 for x = 2..9, y = 3..10: 64 pixels.
     // The diagonal passes through pixel centres; the fill rule must give each to one triangle.
