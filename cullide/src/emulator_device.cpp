@@ -17,17 +17,23 @@ EmulatorDevice::EmulatorDevice(int threads) : threads_(effective_threads(threads
 
 void EmulatorDevice::set_threads(int threads) { threads_ = effective_threads(threads); }
 
+Result<bool> EmulatorDevice::ensure_target(int width, int height, raster::DepthFormat format) {
+    if (target_ && target_->width() == width && target_->height() == height && target_->format() == format)
+        return false;
+    raster::Result<raster::DepthTarget> t = raster::DepthTarget::create(width, height, format);
+    if (!t) return Error{"emulator device: " + t.error().message};
+    target_.emplace(std::move(t).value());
+    // A new target is created cleared to 1.0: nothing written yet.
+    constexpr int side = raster::kExecuteTileSize;
+    tiles_x_ = (width + side - 1) / side;
+    written_tiles_.assign(static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>((height + side - 1) / side), 0);
+    return true;
+}
+
 Status EmulatorDevice::clear(int width, int height, raster::DepthFormat format) {
-    if (!target_ || target_->width() != width || target_->height() != height || target_->format() != format) {
-        raster::Result<raster::DepthTarget> t = raster::DepthTarget::create(width, height, format);
-        if (!t) return Error{"emulator device: " + t.error().message};
-        target_.emplace(std::move(t).value());
-        // A new target is created cleared to 1.0: nothing written yet.
-        constexpr int side = raster::kExecuteTileSize;
-        tiles_x_ = (width + side - 1) / side;
-        written_tiles_.assign(static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>((height + side - 1) / side), 0);
-        return Status{};
-    }
+    Result<bool> created = ensure_target(width, height, format);
+    if (!created) return created.error();
+    if (created.value()) return Status{};
     // Only the tiles where raster::execute ran a writing draw (ExecuteOptions::written_tiles) can
     // differ from depth 1.0: restoring them gives the same buffer as a full clear. In parallel over
     // rows of tiles (each task fills its own pixels).
@@ -69,10 +75,13 @@ raster::ExecuteOptions EmulatorDevice::execute_options() {
 
 Result<std::vector<raster::QueryResults>> EmulatorDevice::execute_cleared(
     int width, int height, raster::DepthFormat format, std::span<const raster::CommandBatch* const> batches) {
-    if (Status s = clear(width, height, format); !s) return s.error();
-    // Between batches the same partial clear as clear() (the size and format are already right).
-    raster::Result<std::vector<raster::QueryResults>> r = raster::execute_sequence(
-        *target_, batches, execute_options(), [&](std::size_t) { (void)clear(width, height, format); });
+    if (Result<bool> created = ensure_target(width, height, format); !created) return created.error();
+    // Each batch on a cleared target, as clear() before it, but each written tile is restored by
+    // its own tile task before it draws there (ExecuteOptions::clear_depth): in parallel with the
+    // other tiles' work and while the tile is in that core's cache, without a pass of its own.
+    raster::ExecuteOptions options = execute_options();
+    options.clear_depth = 1.0;
+    raster::Result<std::vector<raster::QueryResults>> r = raster::execute_sequence(*target_, batches, options);
     if (!r) return Error{"emulator device: " + r.error().message};
     return std::move(r).value();
 }

@@ -45,6 +45,9 @@ class EmulatorDevice final : public QueryDevice {
     // The executor's options for this device: its thread count, and the written tiles the next
     // clear restores.
     raster::ExecuteOptions execute_options();
+    // Makes target_ a width x height target of `format`: true when it was created (cleared to 1.0,
+    // no tile written), false when the current one already fits (its content kept).
+    Result<bool> ensure_target(int width, int height, raster::DepthFormat format);
 
     int threads_;
     std::optional<raster::DepthTarget> target_;

@@ -1,5 +1,8 @@
 // execute.cpp: the scalar reference executor and the tiled (optionally multithreaded) executor.
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
 #include <atomic>
 #include <cstdint>
 #include <cstdlib>
@@ -80,6 +83,9 @@ void finish_results(const CommandBatch& batch, QueryResults& r) {
 
 Result<QueryResults> execute_reference(DepthTarget& target, const CommandBatch& batch, const ExecuteOptions& options) {
     if (Status s = detail::validate(target, batch); !s) return s.error();
+    if (options.clear_depth) {
+        if (Status s = target.clear(*options.clear_depth); !s) return Error{"execute: clear_depth: " + s.error().message};
+    }
     QueryResults results(batch.query_kinds().size(), 0);
     std::uint32_t active = kNoQuery;
     std::vector<detail::SetupTri> tris;
@@ -422,6 +428,9 @@ struct ShadeContext {
     detail::HizTile* hiz_tiles;   // per tile, owned by the tile's task
     std::uint8_t* written_tiles;  // per tile: set to 1 when a writing draw ran in it (or nullptr)
     std::atomic<bool>* answered;  // per query: an any-samples query already has a passing sample
+    // ExecuteOptions::clear_depth: fill the tile with kTileSize copies of *clear_row first (all
+    // tiles, or with written_tiles those flagged); nullptr: no clear.
+    const std::uint32_t* clear_row;
 };
 
 // Back end of one tile: its bin in command order; counters kept as (query, count) runs.
@@ -436,6 +445,15 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
         ctx.hiz ? &ctx.hiz_tiles[static_cast<std::size_t>(ty) * static_cast<std::size_t>((ctx.width + kTileSize - 1) / kTileSize) +
                                  static_cast<std::size_t>(tx)]
                 : nullptr;
+    const std::size_t tile_index = static_cast<std::size_t>(ty) * static_cast<std::size_t>((ctx.width + kTileSize - 1) / kTileSize) +
+                                   static_cast<std::size_t>(tx);
+    if (ctx.clear_row != nullptr && (ctx.written_tiles == nullptr || ctx.written_tiles[tile_index] != 0)) {
+        // Each row by memcpy from a row of clear values (wide stores on any target; the element
+        // loop of std::fill stored one value per instruction: emulator_device.cpp).
+        for (int y = y0; y <= y1; ++y)
+            std::memcpy(ctx.depth.row(y) + x0, ctx.clear_row, static_cast<std::size_t>(x1 - x0 + 1) * sizeof(std::uint32_t));
+        if (ctx.written_tiles != nullptr) ctx.written_tiles[tile_index] = 0;
+    }
     if (hiz != nullptr) {
         hiz->tile = {x0, y0, x1, y1};
         hiz->valid = 0;  // bounds are read from the buffer afresh in every batch
@@ -477,9 +495,7 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
         if (!counts.empty() && counts.back().first == q) counts.back().second += passed;
         else counts.emplace_back(q, passed);
     }
-    if (wrote && ctx.written_tiles != nullptr)
-        ctx.written_tiles[static_cast<std::size_t>(ty) * static_cast<std::size_t>((ctx.width + kTileSize - 1) / kTileSize) +
-                          static_cast<std::size_t>(tx)] = 1;
+    if (wrote && ctx.written_tiles != nullptr) ctx.written_tiles[tile_index] = 1;
 }
 
 }  // namespace
@@ -508,6 +524,8 @@ Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::spa
         Running(const Running&) = delete;
         Running& operator=(const Running&) = delete;
     } running_scope(running);
+    if (options.clear_depth && !std::isfinite(*options.clear_depth))
+        return Error{"execute: clear_depth is not finite"};
     const int threads = detail::effective_threads(options.threads);
     // Buffers kept from one call to the next on this thread (capacity only: every list is
     // emptied before use, so no result depends on an earlier call). CULLIDE issues thousands of
@@ -538,6 +556,9 @@ Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::spa
     const bool hiz = options.hierarchical_z && hiz_allowed_by_environment() && target.format() != DepthFormat::D32F;
     if (hiz && scratch.hiz_tiles.size() < tiles.count()) scratch.hiz_tiles.resize(tiles.count());
 
+    std::array<std::uint32_t, kTileSize> clear_row{};
+    if (options.clear_depth) clear_row.fill(DepthTarget::encode_clear(*options.clear_depth, target.format()));
+
     std::vector<QueryResults> all_results;
     all_results.reserve(batches.size());
     for (std::size_t k = 0; k < batches.size(); ++k) {
@@ -551,15 +572,16 @@ Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::spa
         const std::size_t n_queries = batch.query_kinds().size();
         if (scratch.answered.size() < n_queries + 1) scratch.answered = std::vector<std::atomic<bool>>(n_queries + 1);
         for (std::size_t q = 0; q <= n_queries; ++q) scratch.answered[q].store(false, std::memory_order_relaxed);
+        // Resized: new entries 0 (nothing written), or 1 when this call clears (content unknown).
         if (options.written_tiles != nullptr && options.written_tiles->size() != tiles.count())
-            options.written_tiles->assign(tiles.count(), 0);
+            options.written_tiles->assign(tiles.count(), options.clear_depth ? 1 : 0);
         draw_infos(batch, draw_list, d0, d1, setup, target.format(), options.allow_simd, hiz, scratch.infos);
         const ShadeContext ctx{draw_list,      setup,           scratch.infos.data(),
                                {target.mutable_values().data(), target.width()},
                                target.width(), target.height(), target.format(),
                                options.allow_simd, hiz, scratch.hiz_tiles.data(),
                                options.written_tiles != nullptr ? options.written_tiles->data() : nullptr,
-                               scratch.answered.data()};
+                               scratch.answered.data(), options.clear_depth ? clear_row.data() : nullptr};
         auto& tile_counts = scratch.tile_counts;
         reset_lists(tile_counts, tiles.count());
         detail::parallel_for(threads, tiles.count(), [&](std::size_t tile) {

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cstdint>
 #include <iterator>
+#include <limits>
+#include <string>
 #include <vector>
 
 #include "raster/raster.h"
@@ -225,4 +227,93 @@ TEST_CASE("written_tiles flags every tile whose pixels a batch changed, and only
     std::vector<std::uint8_t> want(16, 0);
     want[0] = 1;
     CHECK(flags == want);
+}
+
+// ExecuteOptions::clear_depth: each tile task fills its tile before drawing there. The reference is
+// the plain DepthTarget::clear before each batch; the tiled runs start from a target holding
+// unrelated values, so a tile left unfilled shows in the buffer and usually in the counts.
+TEST_CASE("clear_depth gives the buffer and counts of DepthTarget::clear before each batch, with and without written_tiles") {
+    const raster::DepthFormat formats[] = {raster::DepthFormat::D16, raster::DepthFormat::D24,
+                                           raster::DepthFormat::D32F};
+    raster_test::SplitMix64 rng(0xc1ea7);
+    int scenes = 0;
+    std::size_t tiles_skipped = 0;  // tiles the written_tiles runs did not fill (not flagged)
+    for (int s = 0; s < 24; ++s) {
+        raster_test::SceneOptions o;
+        o.width = 40 + static_cast<int>(rng.next() % 200);  // 1 to 4 tiles per side, partial tiles
+        o.height = 40 + static_cast<int>(rng.next() % 200);
+        o.objects = 40;
+        // Three batches, as CULLIDE's passes: each must start from the cleared target.
+        raster_test::Scene batches[3];
+        for (auto& b : batches) raster_test::build_scene(b, rng, o);
+        const raster::DepthFormat format = formats[s % 3];
+        const double clear_depth = (s % 4 == 0) ? 0.75 : 1.0;
+        CAPTURE(s);
+        CAPTURE(o.width);
+        CAPTURE(o.height);
+        // Reference: clear, execute_reference, per batch.
+        auto ref = raster::DepthTarget::create(o.width, o.height, format);
+        REQUIRE(ref.ok());
+        std::vector<raster::QueryResults> want;
+        for (auto& b : batches) {
+            REQUIRE(ref.value().clear(clear_depth).ok());
+            auto r = raster::execute_reference(ref.value(), b.batch);
+            REQUIRE(r.ok());
+            want.push_back(r.value());
+        }
+        const std::vector<std::uint32_t> want_depth(ref.value().values().begin(), ref.value().values().end());
+        const raster::CommandBatch* seq[3] = {&batches[0].batch, &batches[1].batch, &batches[2].batch};
+        for (const int threads : {1, 2, 3}) {
+            for (const bool with_written : {false, true}) {
+                CAPTURE(threads);
+                CAPTURE(with_written);
+                auto t = raster::DepthTarget::create(o.width, o.height, format);
+                REQUIRE(t.ok());
+                for (auto& v : t.value().mutable_values()) v = static_cast<std::uint32_t>(rng.next()) & 0x3fffffffu;
+                std::vector<std::uint8_t> written;  // empty: resized, every tile flagged
+                raster::ExecuteOptions eo{threads};
+                eo.clear_depth = clear_depth;
+                if (with_written) eo.written_tiles = &written;
+                if (threads == 3) {
+                    auto r = raster::execute_sequence(t.value(), seq, eo);
+                    REQUIRE(r.ok());
+                    CHECK(r.value() == want);
+                } else {
+                    for (std::size_t k = 0; k < 3; ++k) {
+                        auto r = raster::execute(t.value(), *seq[k], eo);
+                        REQUIRE(r.ok());
+                        CHECK(r.value() == want[k]);
+                        if (with_written && k == 0)
+                            tiles_skipped += static_cast<std::size_t>(std::count(written.begin(), written.end(), 0));
+                    }
+                }
+                CHECK(std::equal(want_depth.begin(), want_depth.end(), t.value().values().begin(), t.value().values().end()));
+            }
+        }
+        ++scenes;
+    }
+    CHECK(scenes == 24);
+    CHECK(tiles_skipped > 0);  // the written_tiles runs did skip tiles that no draw wrote
+}
+
+TEST_CASE("A non-finite clear_depth is an error naming it, and changes nothing") {
+    auto t = raster::DepthTarget::create(16, 16, raster::DepthFormat::D24);
+    REQUIRE(t.ok());
+    REQUIRE(t.value().clear(0.5).ok());
+    const std::vector<raster::Float4> v = {{-1, -1, 0, 1}, {1, -1, 0, 1}, {0, 1, 0, 1}};
+    const std::vector<std::uint32_t> idx = {0, 1, 2};
+    raster::CommandBatch batch(16, 16);
+    batch.draw(raster::MeshView{v, idx}, raster::DrawState{});
+    const std::vector<std::uint32_t> before(t.value().values().begin(), t.value().values().end());
+    for (const double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+        raster::ExecuteOptions eo{2};
+        eo.clear_depth = bad;
+        auto r = raster::execute(t.value(), batch, eo);
+        REQUIRE_FALSE(r.ok());
+        CHECK(r.error().message == "execute: clear_depth is not finite");
+        auto rr = raster::execute_reference(t.value(), batch, eo);
+        REQUIRE_FALSE(rr.ok());
+        CHECK(rr.error().message.find("clear_depth") != std::string::npos);
+        CHECK(std::vector<std::uint32_t>(t.value().values().begin(), t.value().values().end()) == before);
+    }
 }

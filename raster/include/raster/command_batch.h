@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -77,6 +78,17 @@ struct ExecuteOptions {
     // leaves the others as they are, so that a caller can restore only those tiles. Resized to the
     // tile count (new entries 0) when its size differs.
     std::vector<std::uint8_t>* written_tiles = nullptr;
+    // When set, every batch runs on a target cleared to this depth: the same results and buffer as
+    // DepthTarget::clear(*clear_depth) before each batch (execute_reference does exactly that).
+    // The tiled executor fills each tile in the tile's own task, before its first draw there: in
+    // parallel, and while the tile is in that core's cache (a separate DepthTarget::clear is one
+    // serial pass over the whole buffer). With written_tiles, only the tiles flagged there are
+    // filled, and their flags reset before the batch's draws set them again: the caller's promise
+    // that the other tiles hold this depth already, which execute() keeps from one call to the
+    // next when every call uses the same clear_depth. If written_tiles has to be resized, every
+    // tile is flagged (its content is unknown). Must be finite (values outside [0, 1] clamp, as
+    // DepthTarget::clear).
+    std::optional<double> clear_depth = std::nullopt;
 };
 
 // The side of execute()'s tiles (ExecuteOptions::written_tiles).
