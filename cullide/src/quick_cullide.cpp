@@ -82,13 +82,17 @@ std::uint64_t record_draw(raster::CommandBatch& batch, const Geom& g, const Item
 
 Status run_device(QueryDevice& device, const raster::CommandBatch& batch, ViewSize size, raster::DepthFormat format,
                   raster::QueryResults& out) {
-    if (Status s = device.clear(size.width(), size.height(), format); !s) return s;
-    Result<raster::QueryResults> r = device.execute(batch);
+    // On a cleared target: execute_cleared, so that the emulator restores each written tile in
+    // that tile's own task (ExecuteOptions::clear_depth) instead of a clear pass before it.
+    const raster::CommandBatch* const one[1] = {&batch};
+    Result<std::vector<raster::QueryResults>> r = device.execute_cleared(size.width(), size.height(), format, one);
     if (!r) return r.error();
-    if (r.value().size() != batch.query_kinds().size())
-        return Error{"device returned " + std::to_string(r.value().size()) + " query results for " +
+    if (r.value().size() != 1)
+        return Error{"device returned " + std::to_string(r.value().size()) + " result lists for 1 batch"};
+    if (r.value()[0].size() != batch.query_kinds().size())
+        return Error{"device returned " + std::to_string(r.value()[0].size()) + " query results for " +
                      std::to_string(batch.query_kinds().size()) + " queries"};
-    out = std::move(r).value();
+    out = std::move(r.value()[0]);
     return Status{};
 }
 
