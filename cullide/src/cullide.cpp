@@ -268,8 +268,10 @@ Result<std::uint64_t> recorded_view(std::vector<ObjectGeometry>& g, std::vector<
                                     const CullideOptions& o, ViewSize size, QueryDevice& device, ViewStats& vs) {
     // Both passes are recorded first and run as one sequence, each on a cleared target: a device
     // may share their work (the emulator sets each triangle up once for both).
-    std::array<raster::CommandBatch, 2> batches = {raster::CommandBatch(size.width(), size.height(), o.gpu_rules),
-                                                   raster::CommandBatch(size.width(), size.height(), o.gpu_rules)};
+    // Kept per thread (capacity only: reset empties them), so the lists do not grow afresh in
+    // every view (page faults and copies on the serial path: perf, issue #17).
+    thread_local std::array<raster::CommandBatch, 2> batches = {raster::CommandBatch(1, 1), raster::CommandBatch(1, 1)};
+    for (raster::CommandBatch& b : batches) b.reset(size.width(), size.height(), o.gpu_rules);
     for (int pass = 0; pass < 2; ++pass) {
         if (pass == 1) std::reverse(order.begin(), order.end());  // pass 2 runs backward
         record_pass(batches[static_cast<std::size_t>(pass)], g, order, pass, o.mode, vs);

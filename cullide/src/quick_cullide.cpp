@@ -131,7 +131,8 @@ Result<std::uint64_t> run_pass(const std::vector<Geom>& geoms, std::vector<Item>
                                const QuickOptions& o, ViewSize size, QueryDevice& device, ViewStats& vs) {
     const std::uint8_t proven = forward ? kFFV : kSFV;  // what this pass proves
     const std::uint8_t other = forward ? kSFV : kFFV;   // items with this tag are not drawn
-    raster::CommandBatch batch(size.width(), size.height(), o.gpu_rules);
+    thread_local raster::CommandBatch batch(1, 1);  // memory kept from pass to pass (cullide.cpp's recorded_view)
+    batch.reset(size.width(), size.height(), o.gpu_rules);
     detail::quick_pass_schedule(
         items.size(), forward, [&](std::size_t k) { return items[k].near_lo; },
         [&](std::size_t k) { return items[k].near_hi; },

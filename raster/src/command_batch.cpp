@@ -49,6 +49,13 @@ void CommandBatch::clear() {
     query_kinds_.clear();
 }
 
+void CommandBatch::reset(int target_width, int target_height, RasterRules rules) {
+    clear();
+    width_ = target_width;
+    height_ = target_height;
+    rules_ = rules;
+}
+
 namespace detail {
 
 namespace {

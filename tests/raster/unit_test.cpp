@@ -62,6 +62,36 @@ TEST_CASE("Clear stores GL's encodings of 0, 1/2 and 1 and refuses a non-finite 
     CHECK(s.value(0, 0) == 0xffffu);
 }
 
+TEST_CASE("CommandBatch::reset empties the batch and takes the new size and rules: it runs as a new batch") {
+    const std::vector<raster::Float4> v = {{-0.9f, -0.8f, 0.1f, 1}, {0.7f, -0.6f, 0.2f, 1}, {0.1f, 0.9f, -0.3f, 1}};
+    const std::vector<std::uint32_t> idx = {0, 1, 2};
+    raster::CommandBatch reused(40, 30, raster::RasterRules::Vulkan);
+    reused.begin_query(raster::QueryKind::AnySamplesPassed);
+    reused.draw(raster::MeshView{v, idx}, raster::DrawState{});
+    reused.end_query();
+    reused.reset(24, 20, raster::RasterRules::GlLlvmpipe);
+    CHECK(reused.commands().empty());
+    CHECK(reused.query_kinds().empty());
+    CHECK(reused.target_width() == 24);
+    CHECK(reused.target_height() == 20);
+    CHECK(reused.rules() == raster::RasterRules::GlLlvmpipe);
+    raster::CommandBatch fresh(24, 20);
+    for (raster::CommandBatch* b : {&reused, &fresh}) {
+        b->begin_query(raster::QueryKind::SamplesPassed);
+        b->draw(raster::MeshView{v, idx}, raster::DrawState{});
+        b->end_query();
+    }
+    auto ta = raster::DepthTarget::create(24, 20, DepthFormat::D24).value();
+    auto tb = raster::DepthTarget::create(24, 20, DepthFormat::D24).value();
+    const auto ra = raster::execute(ta, reused);
+    const auto rb = raster::execute(tb, fresh);
+    REQUIRE(ra.ok());
+    REQUIRE(rb.ok());
+    CHECK(ra.value() == rb.value());
+    CHECK(ra.value().at(0) > 0);  // the query saw the triangle
+    CHECK(snapshot(ta) == snapshot(tb));
+}
+
 TEST_CASE("Bad batches are rejected before anything is drawn and name the element") {
     const int W = 16, H = 16;
     auto target = raster::DepthTarget::create(W, H, DepthFormat::D24).value();

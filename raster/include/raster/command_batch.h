@@ -52,6 +52,10 @@ class CommandBatch {
     [[nodiscard]] const std::vector<Command>& commands() const { return commands_; }
     [[nodiscard]] const std::vector<QueryKind>& query_kinds() const { return query_kinds_; }
     void clear();
+    // clear() and a new target size and rules, keeping the memory of the command list: a caller
+    // that records a batch per view (CULLIDE's passes: about a hundred thousand commands per
+    // frame) reuses one instead of growing a new list, with its page faults, every time.
+    void reset(int target_width, int target_height, RasterRules rules = RasterRules::GlLlvmpipe);
 
    private:
     int width_;
