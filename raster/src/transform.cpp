@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <type_traits>
 
 namespace raster {
 
@@ -123,6 +124,29 @@ Double3 view_axes(const OrthoView& view, Double3 world) {
     return Double3{axis_of(world, u), axis_of(world, v), axis_of(world, d)};
 }
 
+namespace {
+
+// The transform of ortho_view_to_clip with the view's axes (u, v, d: view_axis_indices) as
+// constants. Returns the index of the first point whose clip coordinates are not all finite, or
+// points.size(). A point with a coordinate that is not finite is one of those: (inf - lo) * scale
+// is an infinity or NaN, and NaN stays NaN.
+template <int U, int V, int D>
+std::size_t to_clip(const Double3& lo, const Double3& scale, std::span<const Double3> points, Double4* out) {
+    const auto at = [](const Double3& p, auto k) { return k == 0 ? p.x : (k == 1 ? p.y : p.z); };
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const Double3& p = points[i];
+        Double4& c = out[i];
+        c.x = (at(p, std::integral_constant<int, U>{}) - lo.x) * scale.x - 1.0;
+        c.y = (at(p, std::integral_constant<int, V>{}) - lo.y) * scale.y - 1.0;
+        c.z = (at(p, std::integral_constant<int, D>{}) - lo.z) * scale.z - 1.0;
+        c.w = 1.0;
+        if (!(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z))) return i;
+    }
+    return points.size();
+}
+
+}  // namespace
+
 Result<std::size_t> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points,
                                        std::vector<Double4>& out) {
     const Double3 lo = view_axes(view, view.box_min);
@@ -130,18 +154,18 @@ Result<std::size_t> ortho_view_to_clip(const OrthoView& view, std::span<const Do
     Double3 scale;
     for (int k = 0; k < 3; ++k) axis_ref(scale, k) = 2.0 / (axis_of(hi, k) - axis_of(lo, k));
     out.resize(points.size());
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        const Double3& p = points[i];
+    // The axes chosen once per call, not per point (view_axes per point was 3% of a leaves /
+    // rcullide frame, with the transform itself 5%, perf). The same arithmetic on the same values.
+    int u = 0, v = 0, d = 0;
+    view_axis_indices(view.axis, u, v, d);
+    const std::size_t bad = d == 0   ? to_clip<1, 2, 0>(lo, scale, points, out.data())
+                            : d == 1 ? to_clip<2, 0, 1>(lo, scale, points, out.data())
+                                     : to_clip<0, 1, 2>(lo, scale, points, out.data());
+    if (bad != points.size()) {
+        const Double3& p = points[bad];  // the first offence, named as before: its input, or the overflow
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-            return Error{"ortho_view_to_clip: point " + std::to_string(i) + " is not finite"};
-        const Double3 a = view_axes(view, p);
-        Double4& c = out[i];
-        c.x = (a.x - lo.x) * scale.x - 1.0;
-        c.y = (a.y - lo.y) * scale.y - 1.0;
-        c.z = (a.z - lo.z) * scale.z - 1.0;
-        c.w = 1.0;
-        if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z))
-            return Error{"ortho_view_to_clip: point " + std::to_string(i) + " overflows the double range in clip space"};
+            return Error{"ortho_view_to_clip: point " + std::to_string(bad) + " is not finite"};
+        return Error{"ortho_view_to_clip: point " + std::to_string(bad) + " overflows the double range in clip space"};
     }
     return points.size();
 }

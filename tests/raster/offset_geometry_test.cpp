@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <string>
 #include <vector>
 
 #include "raster/raster.h"
@@ -108,6 +110,48 @@ bool box_contains_balls(const raster::OrthoView& v, const raster::OffsetMesh& m,
 }
 
 }  // namespace
+
+TEST_CASE("ortho_view_to_clip is the per-point formula bit for bit, and names the first bad point as non-finite or overflowing") {
+    test::Rng rng(12);
+    std::size_t compared = 0;
+    for (int rep = 0; rep < 90; ++rep) {
+        const auto axis = static_cast<raster::Axis>(rep % 3);
+        const raster::OrthoView v = random_view(rng, axis, raster::DepthFormat::D24);
+        auto pts = random_points(rng, v, 5);
+        // The twin: view_axes per point, then (a - lo) * (2 / (hi - lo)) - 1 per axis.
+        const Double3 lo = raster::view_axes(v, v.box_min), hi = raster::view_axes(v, v.box_max);
+        const double sx = 2.0 / (hi.x - lo.x), sy = 2.0 / (hi.y - lo.y), sz = 2.0 / (hi.z - lo.z);
+        auto c = raster::ortho_view_to_clip(v, pts);
+        REQUIRE(c.ok());
+        for (std::size_t i = 0; i < pts.size(); ++i) {
+            const Double3 a = raster::view_axes(v, pts[i]);
+            const raster::Double4& g = c.value()[i];
+            CHECK(g.x == (a.x - lo.x) * sx - 1.0);
+            CHECK(g.y == (a.y - lo.y) * sy - 1.0);
+            CHECK(g.z == (a.z - lo.z) * sz - 1.0);
+            ++compared;
+        }
+        // A non-finite coordinate on any axis, then an overflow before it: the first one is named.
+        const std::size_t bad = 1 + static_cast<std::size_t>(rep) % (pts.size() - 1);
+        auto broken = pts;
+        const double odd = rep % 2 == 0 ? std::numeric_limits<double>::infinity() : std::numeric_limits<double>::quiet_NaN();
+        (rep % 3 == 0 ? broken[bad].x : rep % 3 == 1 ? broken[bad].y : broken[bad].z) = odd;
+        auto e = raster::ortho_view_to_clip(v, broken);
+        REQUIRE_FALSE(e.ok());
+        CHECK(e.error().message == "ortho_view_to_clip: point " + std::to_string(bad) + " is not finite");
+        // On a tiny box (scale 2e300 per unit) a finite point far outside overflows in clip space.
+        auto tiny = raster::make_ortho_view(axis, {0, 0, 0}, {1e-300, 1e-300, 1e-300}, 8, 8, raster::DepthFormat::D24);
+        REQUIRE(tiny.ok());
+        std::vector<Double3> near(pts.size(), Double3{0.5e-300, 0.25e-300, 0.75e-300});
+        near[bad] = broken[bad];
+        near[bad - 1] = Double3{1e10, -1e10, 1e10};
+        e = raster::ortho_view_to_clip(tiny.value(), near);
+        REQUIRE_FALSE(e.ok());
+        CHECK(e.error().message ==
+              "ortho_view_to_clip: point " + std::to_string(bad - 1) + " overflows the double range in clip space");
+    }
+    CHECK(compared >= 90 * 5);
+}
 
 TEST_CASE("The orthographic view helper maps the box to [-1, 1] within its documented error") {
     test::Rng rng(11);
