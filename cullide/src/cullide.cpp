@@ -142,6 +142,21 @@ Status prepare_geometry(ObjectGeometry& og, CullStage stage, const raster::Ortho
     return Status{};
 }
 
+// The view transform of points [b, e) of an exact-bounds or GL-exact object whose clip_d (and, GL-
+// exact, clip) already hold all its points: prepare_geometry's work for one part of the object.
+// On failure the caller reruns prepare_geometry on the whole object for its message.
+bool transform_part(ObjectGeometry& og, std::size_t b, std::size_t e, const raster::OrthoView& view,
+                    VisibilityMode mode, raster::RasterRules rules) {
+    const std::span<const raster::Double3> points = std::span<const raster::Double3>(og.positions).subspan(b, e - b);
+    if (!raster::ortho_view_to_clip(view, points, std::span<raster::Double4>(og.clip_d).subspan(b, e - b))) return false;
+    if (mode == VisibilityMode::ExactBounds) return true;
+    for (std::size_t i = b; i < e; ++i) {  // as prepare_geometry
+        const raster::Double4& d = og.clip_d[i];
+        og.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), detail::gl_exact_clip_depth(d.z, rules), 1.0f};
+    }
+    return true;
+}
+
 std::uint64_t count_live(const std::vector<ObjectGeometry>& g) {
     std::uint64_t n = 0;
     for (const ObjectGeometry& og : g)
@@ -307,15 +322,43 @@ Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_
     for (int attempt = 0;; ++attempt) {
         Result<raster::OrthoView> view = make_view(axis, bounds, extra_depth, size, o.depth_format);
         if (!view) return view.error();
-        // One object per parallel job (each writes only its own geometry); the first failure in
-        // order is reported.
+        if (o.mode != VisibilityMode::Offset) {
+            // Parts of kTransformPart points per parallel job, each writing only its own part: one
+            // job per object left the second thread idle where one object holds most of the
+            // points (the tree of leaves, the dragon). The first failure in order is reported,
+            // with prepare_geometry's message for its object.
+            constexpr std::size_t kTransformPart = 4096;
+            struct Part {
+                std::size_t k, b, e;
+            };
+            std::vector<Part> parts;
+            for (std::size_t k = 0; k < order.size(); ++k) {
+                ObjectGeometry& og = g[order[k]];
+                const std::size_t n = og.positions.size();
+                og.clip_d.resize(n);
+                if (o.mode == VisibilityMode::GLExact) og.clip.resize(n);
+                for (std::size_t b = 0; b < n; b += kTransformPart) parts.push_back({k, b, std::min(n, b + kTransformPart)});
+            }
+            std::vector<char> ok(parts.size(), 0);
+            detail::parallel_chunks(o.threads, parts.size(), [&](std::size_t j) {
+                ok[j] = transform_part(g[order[parts[j].k]], parts[j].b, parts[j].e, view.value(), o.mode, o.gpu_rules) ? 1 : 0;
+            });
+            for (std::size_t j = 0; j < parts.size(); ++j) {
+                if (ok[j]) continue;
+                Status s = prepare_geometry(g[order[parts[j].k]], stage, view.value(), o.mode, o.gpu_rules);
+                if (s) return Error{"view transform: a part of an object failed but the whole object passed"};
+                return s;
+            }
+            return Status{};
+        }
+        // Offset solids: one object per parallel job (each writes only its own geometry); the
+        // first failure in order is reported.
         std::vector<Status> prepared(order.size());
         detail::parallel_chunks(o.threads, order.size(), [&](std::size_t k) {
             prepared[k] = prepare_geometry(g[order[k]], stage, view.value(), o.mode, o.gpu_rules);
         });
         for (const Status& s : prepared)
             if (!s) return s;
-        if (o.mode != VisibilityMode::Offset) return Status{};
         double overshoot = 0.0;  // in clip units beyond [-1, 1]
         for (std::size_t i : order)
             for (const raster::Float4& v : g[i].offset.vertices)
@@ -456,19 +499,32 @@ std::vector<ObjectGeometry> subobject_geometry(std::span<const Mesh> objects, st
     std::vector<ObjectGeometry> subs;
     for (ObjectGeometry& og : whole)
         if (og.items[0].live) subs.push_back(std::move(og));
-    // One object per parallel job: each fills only its own geometry.
-    detail::parallel_chunks(threads, subs.size(), [&](std::size_t k) {
+    // Parts of whole sub-objects (about kBoxPart triangles) per parallel job, each filling only its
+    // own triangle boxes and items: one job per object left the second thread idle where one object
+    // holds most of the triangles (the tree of leaves, the dragon, the cloth).
+    constexpr std::size_t kBoxPart = 4096;
+    const std::size_t per_part = group * std::max<std::size_t>(1, kBoxPart / group);
+    struct Part {
+        std::size_t k, first, last;  // triangles [first, last) of subs[k]
+    };
+    std::vector<Part> parts;
+    for (std::size_t k = 0; k < subs.size(); ++k) {
         ObjectGeometry& og = subs[k];
+        const std::size_t n = objects[active[og.active_index]].triangles.size();
+        og.triangle_boxes.resize(n);
+        og.items.assign((n + group - 1) / group, Item{});
+        for (std::size_t first = 0; first < n; first += per_part) parts.push_back({k, first, std::min(n, first + per_part)});
+    }
+    detail::parallel_chunks(threads, parts.size(), [&](std::size_t j) {
+        ObjectGeometry& og = subs[parts[j].k];
         const Mesh& m = objects[active[og.active_index]];
-        og.items.clear();
-        og.triangle_boxes.resize(m.triangles.size());
-        for (std::size_t t = 0; t < m.triangles.size(); ++t) og.triangle_boxes[t] = triangle_bounds(m, t);
-        for (std::size_t first = 0; first < m.triangles.size(); first += group) {
-            const std::size_t last = std::min(m.triangles.size(), first + group);
+        for (std::size_t t = parts[j].first; t < parts[j].last; ++t) og.triangle_boxes[t] = triangle_bounds(m, t);
+        for (std::size_t first = parts[j].first; first < parts[j].last; first += group) {
+            const std::size_t last = std::min(parts[j].last, first + group);
             Aabb b;
             for (std::size_t t = first; t < last; ++t) b = unite(b, og.triangle_boxes[t]);
-            og.items.push_back(
-                {static_cast<std::uint32_t>(first * 3), static_cast<std::uint32_t>((last - first) * 3), b, true, {}});
+            og.items[first / group] = {static_cast<std::uint32_t>(first * 3), static_cast<std::uint32_t>((last - first) * 3),
+                                       b, true, {}};
         }
     });
     return subs;

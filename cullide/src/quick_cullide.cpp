@@ -103,23 +103,42 @@ Status transform_geoms(std::vector<Geom>& geoms, const std::vector<char>& geom_l
     std::vector<std::size_t> live;
     for (std::size_t gi = 0; gi < geoms.size(); ++gi)
         if (geom_live[gi]) live.push_back(gi);
-    std::vector<std::string> errors(live.size());
-    detail::parallel_chunks(threads, live.size(), [&](std::size_t j) {
-        Geom& g = geoms[live[j]];
-        raster::Result<std::size_t> c = raster::ortho_view_to_clip(view, g.positions, g.clip_d);
-        if (!c) {
-            errors[j] = "view transform: " + c.error().message;
+    // Parts of kTransformPart positions per parallel job, each writing only its own part (one job
+    // per geometry left the second thread idle on one-object scenes such as the cloth).
+    constexpr std::size_t kTransformPart = 4096;
+    struct Part {
+        std::size_t gi, b, e;
+    };
+    std::vector<Part> parts;
+    for (const std::size_t gi : live) {
+        Geom& g = geoms[gi];
+        const std::size_t n = g.positions.size();
+        g.clip_d.resize(n);
+        if (mode != VisibilityMode::ExactBounds) g.clip.resize(n);
+        for (std::size_t b = 0; b < n; b += kTransformPart) parts.push_back({gi, b, std::min(n, b + kTransformPart)});
+    }
+    std::vector<char> ok(parts.size(), 0);
+    detail::parallel_chunks(threads, parts.size(), [&](std::size_t j) {
+        Geom& g = geoms[parts[j].gi];
+        const std::size_t b = parts[j].b, e = parts[j].e;
+        if (!raster::ortho_view_to_clip(view, std::span<const raster::Double3>(g.positions).subspan(b, e - b),
+                                        std::span<raster::Double4>(g.clip_d).subspan(b, e - b)))
             return;
+        if (mode != VisibilityMode::ExactBounds) {
+            for (std::size_t i = b; i < e; ++i) {
+                const raster::Double4& d = g.clip_d[i];
+                g.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), detail::gl_exact_clip_depth(d.z, rules), 1.0f};
+            }
         }
-        if (mode == VisibilityMode::ExactBounds) return;
-        g.clip.resize(g.clip_d.size());
-        for (std::size_t i = 0; i < g.clip.size(); ++i) {
-            const raster::Double4& d = g.clip_d[i];
-            g.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), detail::gl_exact_clip_depth(d.z, rules), 1.0f};
-        }
+        ok[j] = 1;
     });
-    for (const std::string& e : errors)
-        if (!e.empty()) return Error{e};
+    for (std::size_t j = 0; j < parts.size(); ++j) {
+        if (ok[j]) continue;
+        // The first failure in geometry order, named as the whole geometry's transform names it.
+        raster::Result<std::size_t> c = raster::ortho_view_to_clip(view, geoms[parts[j].gi].positions, geoms[parts[j].gi].clip_d);
+        if (c) return Error{"view transform: a part of a geometry failed but the whole geometry passed"};
+        return Error{"view transform: " + c.error().message};
+    }
     return Status{};
 }
 

@@ -149,11 +149,19 @@ std::size_t to_clip(const Double3& lo, const Double3& scale, std::span<const Dou
 
 Result<std::size_t> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points,
                                        std::vector<Double4>& out) {
+    out.resize(points.size());
+    return ortho_view_to_clip(view, points, std::span<Double4>(out));
+}
+
+Result<std::size_t> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points,
+                                       std::span<Double4> out) {
+    if (out.size() != points.size())
+        return Error{"ortho_view_to_clip: the output holds " + std::to_string(out.size()) + " points for " +
+                     std::to_string(points.size())};
     const Double3 lo = view_axes(view, view.box_min);
     const Double3 hi = view_axes(view, view.box_max);
     Double3 scale;
     for (int k = 0; k < 3; ++k) axis_ref(scale, k) = 2.0 / (axis_of(hi, k) - axis_of(lo, k));
-    out.resize(points.size());
     // The axes chosen once per call, not per point (view_axes per point was 3% of a leaves /
     // rcullide frame, with the transform itself 5%, perf). The same arithmetic on the same values.
     int u = 0, v = 0, d = 0;

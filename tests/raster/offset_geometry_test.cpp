@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -131,6 +132,20 @@ TEST_CASE("ortho_view_to_clip is the per-point formula bit for bit, and names th
             CHECK(g.z == (a.z - lo.z) * sz - 1.0);
             ++compared;
         }
+        // The span overload on a part of the points writes that part of the output, the same bits.
+        std::vector<raster::Double4> part_out(pts.size(), raster::Double4{7, 7, 7, 7});
+        auto part = raster::ortho_view_to_clip(v, std::span<const Double3>(pts).subspan(1, 3),
+                                               std::span<raster::Double4>(part_out).subspan(1, 3));
+        REQUIRE(part.ok());
+        CHECK(part.value() == 3);
+        for (std::size_t i = 0; i < pts.size(); ++i) {
+            const bool inside = i >= 1 && i < 4;
+            CHECK(part_out[i].x == (inside ? c.value()[i].x : 7.0));
+            CHECK(part_out[i].z == (inside ? c.value()[i].z : 7.0));
+        }
+        auto wrong = raster::ortho_view_to_clip(v, pts, std::span<raster::Double4>(part_out).subspan(0, 2));
+        REQUIRE_FALSE(wrong.ok());
+        CHECK(wrong.error().message == "ortho_view_to_clip: the output holds 2 points for 5");
         // A non-finite coordinate on any axis, then an overflow before it: the first one is named.
         const std::size_t bad = 1 + static_cast<std::size_t>(rep) % (pts.size() - 1);
         auto broken = pts;

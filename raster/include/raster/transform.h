@@ -83,6 +83,11 @@ void view_axis_indices(Axis axis, int& u, int& v, int& d);
 // the same geometry view after view allocates only while it grows). On failure `out` is unspecified.
 [[nodiscard]] Result<std::size_t> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points,
                                                      std::vector<Double4>& out);
+// The same into a caller's span of exactly points.size() elements (an error otherwise), so that
+// parts of one large point list can be transformed in parallel into their own parts of one output.
+// Errors name the index within `points`.
+[[nodiscard]] Result<std::size_t> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points,
+                                                     std::span<Double4> out);
 
 // The view's cell in world units: dx, dy = one pixel along u, v; dz = one depth quantum along d
 // (D16: 1/65535, D24: 1/16777215, D32F: 2^-24, the largest float spacing in [0.5, 1]) times the
