@@ -112,6 +112,44 @@ TEST_CASE("welding treats -0.0 and 0.0 as one vertex and numbers ids by first ap
     CHECK(id == std::vector<std::uint32_t>{0, 1, 0, 1, 2});
 }
 
+TEST_CASE("welding equals its definition on random meshes full of repeats, signed zeros and NaN") {
+    // The twin: a vertex's id is the id of the first earlier vertex whose position compares equal,
+    // else the next one (quadratic, obviously right).
+    const auto naive = [](const Mesh& m) {
+        std::vector<std::uint32_t> id(m.positions.size());
+        std::uint32_t next = 0;
+        for (std::size_t v = 0; v < m.positions.size(); ++v) {
+            std::size_t u = 0;
+            while (u < v && !(m.positions[u] == m.positions[v])) ++u;
+            id[v] = u < v ? id[u] : next++;
+        }
+        return id;
+    };
+    test::Rng rng(4242);
+    std::size_t welded = 0;
+    for (int round = 0; round < 60; ++round) {
+        Mesh m;
+        const std::size_t n = 1 + rng.below(round < 50 ? 400 : 3000);
+        const double values[] = {0.0, -0.0, 1.0, -1.0, 0.5, 1e-300, -1e300, 3.0};
+        for (std::size_t v = 0; v < n; ++v) {
+            if (v > 0 && rng.below(3) == 0) {  // a repeat of an earlier position, with a signed zero swapped
+                Vec3 q = m.positions[rng.below(static_cast<std::uint32_t>(v))];
+                if (q.y == 0.0 && rng.below(2) == 0) q.y = -q.y;
+                m.positions.push_back(q);
+            } else {
+                m.positions.push_back({values[rng.below(8)], values[rng.below(8)], rng.uniform(-2, 2) * (rng.below(4) == 0 ? 0 : 1)});
+            }
+            if (round % 7 == 0 && rng.below(50) == 0) m.positions.back().z = std::numeric_limits<double>::quiet_NaN();
+        }
+        const auto got = cullide::weld_vertices(m);
+        const auto want = naive(m);
+        CAPTURE(round);
+        CHECK(got == want);
+        welded += n - (want.empty() ? 0 : *std::max_element(want.begin(), want.end()) + 1);
+    }
+    CHECK(welded > 1000);  // many vertices did weld
+}
+
 TEST_CASE("touching objects collide: a shared vertex between two objects is a pair") {
     Mesh a, b;
     a.name = "a";

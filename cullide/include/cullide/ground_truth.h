@@ -59,8 +59,9 @@ struct ExactStats {
 // The object pairs of a sorted triangle-pair list, sorted and unique.
 [[nodiscard]] std::vector<ObjectPair> object_pairs(std::span<const TrianglePair> pairs);
 
-// Welded vertex ids of one mesh: equal ids exactly when positions compare equal (so -0.0 == 0.0).
-// Ids are dense, numbered in order of first appearance in the vertex list.
+// Welded vertex ids of one mesh: equal ids exactly when positions compare equal (so -0.0 == 0.0;
+// a position with a NaN coordinate equals no other). Ids are dense, numbered in order of first
+// appearance in the vertex list.
 [[nodiscard]] std::vector<std::uint32_t> weld_vertices(const Mesh& mesh);
 
 }  // namespace cullide
