@@ -917,12 +917,32 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> overlapping_sets(
                            const std::uint32_t lo = std::min(a.set, b.set), hi = std::max(a.set, b.set);
                            if (!keep || keep(lo, hi)) found[u].emplace_back(lo, hi);
                        });
+        // Each chunk's pairs sorted in its own job; the runs are merged below. The serial sort of
+        // all of them was 1.9% of a qcullide --self cloth frame (perf). The same sorted multiset.
+        std::sort(found[u].begin(), found[u].end());
     });
     overlapping = 0;
     for (std::uint64_t n : seen) overlapping += n;
     std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
-    for (const auto& f : found) out.insert(out.end(), f.begin(), f.end());
-    std::sort(out.begin(), out.end());
+    std::vector<std::size_t> run_start;  // out's sorted runs, one per non-empty chunk
+    for (const auto& f : found) {
+        if (f.empty()) continue;
+        run_start.push_back(out.size());
+        out.insert(out.end(), f.begin(), f.end());
+    }
+    // Merge neighbouring runs pairwise until one is left (log2 of the run count rounds).
+    while (run_start.size() > 1) {
+        std::vector<std::size_t> next;
+        for (std::size_t r = 0; r < run_start.size(); r += 2) {
+            next.push_back(run_start[r]);
+            if (r + 1 == run_start.size()) break;
+            const std::size_t end = r + 2 < run_start.size() ? run_start[r + 2] : out.size();
+            std::inplace_merge(out.begin() + static_cast<std::ptrdiff_t>(run_start[r]),
+                               out.begin() + static_cast<std::ptrdiff_t>(run_start[r + 1]),
+                               out.begin() + static_cast<std::ptrdiff_t>(end));
+        }
+        run_start = std::move(next);
+    }
     return out;
 }
 

@@ -370,6 +370,44 @@ TEST_CASE("a big object in many pair tasks (walked in spatial order) gives the s
     }
 }
 
+TEST_CASE("overlapping_sets gives the sorted multiset of overlapping set pairs of a brute-force double loop") {
+    test::Rng rng(777);
+    std::size_t total_pairs = 0;
+    for (const std::size_t n : {std::size_t{1}, std::size_t{40}, std::size_t{3000}, std::size_t{9000}}) {  // 1 to 5 sweep chunks
+        std::vector<cullide::detail::SweepRef> refs(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            const double x = rng.uniform(0, 60), y = rng.uniform(0, 3), z = rng.uniform(0, 3);
+            const double e = rng.uniform(0.05, 0.6);
+            refs[i].box = {{x, y, z}, {x + e, y + e, z + e}};
+            refs[i].object = static_cast<std::uint32_t>(rng.below(4));
+            refs[i].set = static_cast<std::uint32_t>(rng.below(n / 2 + 1));  // sets of several parts: repeated pairs
+            refs[i].part = static_cast<std::uint32_t>(i);
+        }
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> want;
+        for (std::size_t i = 0; i < n; ++i)
+            for (std::size_t j = i + 1; j < n; ++j)
+                if (cullide::overlaps(refs[i].box, refs[j].box))
+                    want.emplace_back(std::min(refs[i].set, refs[j].set), std::max(refs[i].set, refs[j].set));
+        std::sort(want.begin(), want.end());
+        for (const int threads : {1, 2, 3}) {
+            CAPTURE(n);
+            CAPTURE(threads);
+            CHECK(cullide::detail::overlapping_sets(refs, threads) == want);
+            // With a filter: the kept pairs in the same order, and the count of all overlaps.
+            std::uint64_t overlapping = 0;
+            const auto odd = cullide::detail::overlapping_sets(
+                refs, threads, [](std::uint32_t a, std::uint32_t b) { return (a + b) % 2 == 1; }, overlapping);
+            std::vector<std::pair<std::uint32_t, std::uint32_t>> want_odd;
+            for (const auto& p : want)
+                if ((p.first + p.second) % 2 == 1) want_odd.push_back(p);
+            CHECK(odd == want_odd);
+            CHECK(overlapping == want.size());
+        }
+        total_pairs += want.size();
+    }
+    CHECK(total_pairs > 10000);
+}
+
 TEST_CASE("the result is the same for 1, 2, 3 and 8 threads") {
     std::vector<Mesh> scene = random_scene(77, 40, 120, true);
     cullide::ExactStats s1;
