@@ -458,9 +458,10 @@ std::vector<TrianglePair> exact_stage(std::span<const Mesh> objects, std::span<c
 }
 
 // Stage 1's geometry: each active object's box as one item of 12 triangles.
-std::vector<ObjectGeometry> box_geometry(std::span<const Mesh> objects, std::span<const std::uint32_t> active) {
+std::vector<ObjectGeometry> box_geometry(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                                         int threads) {
     std::vector<ObjectGeometry> boxes(active.size());
-    for (std::size_t k = 0; k < active.size(); ++k) {
+    detail::parallel_chunks(threads, active.size(), [&](std::size_t k) {  // each fills its own geometry
         ObjectGeometry& og = boxes[k];
         og.active_index = static_cast<std::uint32_t>(k);
         const Aabb b = mesh_bounds(objects[active[k]]);
@@ -469,7 +470,7 @@ std::vector<ObjectGeometry> box_geometry(std::span<const Mesh> objects, std::spa
             og.positions[c] = {(c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z};
         og.indices.assign(kBoxIndices.begin(), kBoxIndices.end());
         og.items.push_back({0, 36, b, true, {}});
-    }
+    });
     return boxes;
 }
 
@@ -542,7 +543,7 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
     st.objects_in = active.size();
 
     auto t0 = Clock::now();
-    std::vector<ObjectGeometry> boxes = box_geometry(objects, active);
+    std::vector<ObjectGeometry> boxes = box_geometry(objects, active, options.threads);
     if (Status s = run_stage(boxes, CullStage::Boxes, options, size, device, st); !s) return s.error();
     st.pcs_boxes = count_live(boxes);
     st.boxes_ms = ms_since(t0);

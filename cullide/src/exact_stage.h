@@ -33,6 +33,9 @@
 
 namespace cullide::detail {
 
+// validate_exact_range (ground_truth.h) for one object, named as object `index` of its scene.
+[[nodiscard]] Status validate_exact_range_of(const Mesh& m, std::size_t index);
+
 // ---- The sweep and prune -------------------------------------------------------------------------
 
 // A box in a sweep: a whole candidate set (part == kWholeSet) or one triangle (part = its position

@@ -71,22 +71,29 @@ std::vector<ObjectPair> object_pairs(std::span<const TrianglePair> pairs) {
     return out;
 }
 
-Status validate_exact_range(std::span<const Mesh> objects) {
-    // The exact predicates are exact only inside their range (predicates.h): refuse, never guess.
-    for (std::size_t i = 0; i < objects.size(); ++i) {
-        const Mesh& m = objects[i];
-        for (std::size_t v = 0; v < m.positions.size(); ++v) {
-            for (int k = 0; k < 3; ++k) {
-                if (!predicate_coordinate_ok(m.positions[v][k])) {
-                    char value[32];
-                    std::snprintf(value, sizeof value, "%.17g", m.positions[v][k]);
-                    return Error{"object " + std::to_string(i) + ": mesh '" + m.name + "': vertex " +
-                                 std::to_string(v) + " coordinate " + "xyz"[k] + " = " + value +
-                                 " is outside the exact range (0, or 2^-300 <= |x| <= 2^300)"};
-                }
+namespace detail {
+
+Status validate_exact_range_of(const Mesh& m, std::size_t index) {
+    for (std::size_t v = 0; v < m.positions.size(); ++v) {
+        for (int k = 0; k < 3; ++k) {
+            if (!predicate_coordinate_ok(m.positions[v][k])) {
+                char value[32];
+                std::snprintf(value, sizeof value, "%.17g", m.positions[v][k]);
+                return Error{"object " + std::to_string(index) + ": mesh '" + m.name + "': vertex " + std::to_string(v) +
+                             " coordinate " + "xyz"[k] + " = " + value +
+                             " is outside the exact range (0, or 2^-300 <= |x| <= 2^300)"};
             }
         }
     }
+    return {};
+}
+
+}  // namespace detail
+
+Status validate_exact_range(std::span<const Mesh> objects) {
+    // The exact predicates are exact only inside their range (predicates.h): refuse, never guess.
+    for (std::size_t i = 0; i < objects.size(); ++i)
+        if (Status s = detail::validate_exact_range_of(objects[i], i); !s) return s;
     return {};
 }
 

@@ -332,13 +332,14 @@ TEST_CASE("every method refuses coordinates outside the exact range, as the grou
     }
 }
 
-TEST_CASE("exact and auto, checked in exact_pairs' scan, name the first problem the serial checks name") {
+TEST_CASE("every method names the first problem the serial scene checks name (exact and auto in exact_pairs' scan)") {
     // process_frame leaves the scene checks of a frame that goes straight to exact_pairs over every
     // object to exact_pairs' parallel scan: the message must be the one validate_scene, then
     // validate_exact_range, give, naming the first problem in that order.
     const auto scene = [] {
         std::vector<cullide::Mesh> objects;
-        for (int o = 0; o < 4; ++o) objects.push_back(cube({0.4 * o, 0, 0}, 1.0, std::string("c").append(std::to_string(o))));
+        // Six cubes of 12 triangles: more than kSerialFrameTriangles (64), so the checks run in parallel jobs.
+        for (int o = 0; o < 6; ++o) objects.push_back(cube({0.4 * o, 0, 0}, 1.0, std::string("c").append(std::to_string(o))));
         return objects;
     };
     struct Case {
@@ -376,9 +377,12 @@ TEST_CASE("exact and auto, checked in exact_pairs' scan, name the first problem 
         if (serial) serial = cullide::validate_exact_range(c.objects);
         REQUIRE_FALSE(serial.ok());
         CHECK(serial.error().message.find(c.must_name) != std::string::npos);
-        for (Method m : {Method::Exact, Method::Auto})
+        // exact and auto check in exact_pairs' scan; the visibility methods in process_frame's
+        // parallel per-object checks (session 11): every one names the serial scans' first problem.
+        for (Method m : {Method::Exact, Method::Auto, Method::RCullide, Method::Cullide, Method::QCullide})
             for (bool self : {false, true})
-                for (int threads : {1, 2}) {
+                for (int threads : {1, 2, 3}) {
+                    if (self && (m == Method::RCullide || m == Method::Cullide)) continue;
                     CAPTURE(cullide::to_string(m));
                     CAPTURE(self);
                     CAPTURE(threads);
