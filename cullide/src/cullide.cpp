@@ -109,6 +109,16 @@ Result<raster::OrthoView> make_view(int axis, const Aabb& bounds, double extra_d
     return v.value();
 }
 
+bool transform_to_clip(const raster::OrthoView& view, std::span<const raster::Double3> points,
+                       std::span<raster::Double4> clip_d, std::span<raster::Float4> clip, raster::RasterRules rules) {
+    if (!raster::ortho_view_to_clip(view, points, clip_d)) return false;
+    for (std::size_t i = 0; i < clip.size(); ++i) {
+        const raster::Double4& d = clip_d[i];
+        clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), gl_exact_clip_depth(d.z, rules), 1.0f};
+    }
+    return true;
+}
+
 }  // namespace detail
 
 namespace {
@@ -116,45 +126,17 @@ namespace {
 using detail::make_view;
 using detail::unite;
 
-// This view's geometry of one object (see ObjectGeometry).
-Status prepare_geometry(ObjectGeometry& og, CullStage stage, const raster::OrthoView& view, VisibilityMode mode,
-                        raster::RasterRules rules) {
-    if (mode == VisibilityMode::Offset) {
-        raster::Result<raster::OffsetMesh> m =
-            stage == CullStage::Objects ? raster::object_offset_obbs(view, og.positions, og.indices)
-            : stage == CullStage::Boxes
-                // The box of the degenerate triangle (lo, hi, lo) is the object's box.
-                ? raster::triangle_offset_boxes(view, og.positions, std::array<std::uint32_t, 3>{0, 7, 0})
-                : raster::triangle_offset_boxes(view, og.positions, og.indices);
-        if (!m) return Error{"offset geometry: " + m.error().message};
-        og.offset = std::move(m).value();
-        return Status{};
-    }
-    raster::Result<std::size_t> c = raster::ortho_view_to_clip(view, og.positions, og.clip_d);
-    if (!c) return Error{"view transform: " + c.error().message};
-    if (mode == VisibilityMode::ExactBounds) return Status{};
-    // GL-exact: one rounding to nearest float per coordinate; the same floats go to any device.
-    og.clip.resize(og.clip_d.size());
-    for (std::size_t i = 0; i < og.clip.size(); ++i) {
-        const raster::Double4& d = og.clip_d[i];
-        og.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), detail::gl_exact_clip_depth(d.z, rules), 1.0f};
-    }
+// This view's offset solids of one object (see ObjectGeometry).
+Status prepare_offset_geometry(ObjectGeometry& og, CullStage stage, const raster::OrthoView& view) {
+    raster::Result<raster::OffsetMesh> m =
+        stage == CullStage::Objects ? raster::object_offset_obbs(view, og.positions, og.indices)
+        : stage == CullStage::Boxes
+            // The box of the degenerate triangle (lo, hi, lo) is the object's box.
+            ? raster::triangle_offset_boxes(view, og.positions, std::array<std::uint32_t, 3>{0, 7, 0})
+            : raster::triangle_offset_boxes(view, og.positions, og.indices);
+    if (!m) return Error{"offset geometry: " + m.error().message};
+    og.offset = std::move(m).value();
     return Status{};
-}
-
-// The view transform of points [b, e) of an exact-bounds or GL-exact object whose clip_d (and, GL-
-// exact, clip) already hold all its points: prepare_geometry's work for one part of the object.
-// On failure the caller reruns prepare_geometry on the whole object for its message.
-bool transform_part(ObjectGeometry& og, std::size_t b, std::size_t e, const raster::OrthoView& view,
-                    VisibilityMode mode, raster::RasterRules rules) {
-    const std::span<const raster::Double3> points = std::span<const raster::Double3>(og.positions).subspan(b, e - b);
-    if (!raster::ortho_view_to_clip(view, points, std::span<raster::Double4>(og.clip_d).subspan(b, e - b))) return false;
-    if (mode == VisibilityMode::ExactBounds) return true;
-    for (std::size_t i = b; i < e; ++i) {  // as prepare_geometry
-        const raster::Double4& d = og.clip_d[i];
-        og.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), detail::gl_exact_clip_depth(d.z, rules), 1.0f};
-    }
-    return true;
 }
 
 std::uint64_t count_live(const std::vector<ObjectGeometry>& g) {
@@ -323,11 +305,9 @@ Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_
         Result<raster::OrthoView> view = make_view(axis, bounds, extra_depth, size, o.depth_format);
         if (!view) return view.error();
         if (o.mode != VisibilityMode::Offset) {
-            // Parts of kTransformPart points per parallel job, each writing only its own part: one
-            // job per object left the second thread idle where one object holds most of the
-            // points (the tree of leaves, the dragon). The first failure in order is reported,
-            // with prepare_geometry's message for its object.
-            constexpr std::size_t kTransformPart = 4096;
+            // Parts of detail::kTransformPart points per parallel job, each writing only its own
+            // part of its object's clip arrays; the first failure in order is reported, named by
+            // the whole object's transform.
             struct Part {
                 std::size_t k, b, e;
             };
@@ -337,17 +317,26 @@ Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_
                 const std::size_t n = og.positions.size();
                 og.clip_d.resize(n);
                 if (o.mode == VisibilityMode::GLExact) og.clip.resize(n);
-                for (std::size_t b = 0; b < n; b += kTransformPart) parts.push_back({k, b, std::min(n, b + kTransformPart)});
+                for (std::size_t b = 0; b < n; b += detail::kTransformPart)
+                    parts.push_back({k, b, std::min(n, b + detail::kTransformPart)});
             }
             std::vector<char> ok(parts.size(), 0);
             detail::parallel_chunks(o.threads, parts.size(), [&](std::size_t j) {
-                ok[j] = transform_part(g[order[parts[j].k]], parts[j].b, parts[j].e, view.value(), o.mode, o.gpu_rules) ? 1 : 0;
+                ObjectGeometry& og = g[order[parts[j].k]];
+                const std::size_t b = parts[j].b, len = parts[j].e - parts[j].b;
+                const std::span<raster::Float4> clip =
+                    o.mode == VisibilityMode::GLExact ? std::span<raster::Float4>(og.clip).subspan(b, len)
+                                                      : std::span<raster::Float4>();
+                ok[j] = detail::transform_to_clip(view.value(), std::span<const raster::Double3>(og.positions).subspan(b, len),
+                                                  std::span<raster::Double4>(og.clip_d).subspan(b, len), clip, o.gpu_rules)
+                            ? 1 : 0;
             });
             for (std::size_t j = 0; j < parts.size(); ++j) {
                 if (ok[j]) continue;
-                Status s = prepare_geometry(g[order[parts[j].k]], stage, view.value(), o.mode, o.gpu_rules);
-                if (s) return Error{"view transform: a part of an object failed but the whole object passed"};
-                return s;
+                ObjectGeometry& og = g[order[parts[j].k]];
+                raster::Result<std::size_t> c = raster::ortho_view_to_clip(view.value(), og.positions, og.clip_d);
+                if (c) return Error{"view transform: a part of an object failed but the whole object passed"};
+                return Error{"view transform: " + c.error().message};
             }
             return Status{};
         }
@@ -355,7 +344,7 @@ Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_
         // first failure in order is reported.
         std::vector<Status> prepared(order.size());
         detail::parallel_chunks(o.threads, order.size(), [&](std::size_t k) {
-            prepared[k] = prepare_geometry(g[order[k]], stage, view.value(), o.mode, o.gpu_rules);
+            prepared[k] = prepare_offset_geometry(g[order[k]], stage, view.value());
         });
         for (const Status& s : prepared)
             if (!s) return s;

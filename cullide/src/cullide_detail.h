@@ -28,6 +28,18 @@ void widen(double& lo, double& hi);
     return static_cast<float>(rules == raster::RasterRules::Vulkan ? (clip_z + 1.0) * 0.5 : clip_z);
 }
 
+// Points per parallel job of a view's transform: one job per object left the second thread idle
+// where one object holds most of the points (the tree of leaves, the dragon, the cloth).
+inline constexpr std::size_t kTransformPart = 4096;
+
+// One part of an object's points into the same part of its clip arrays (spans of equal length), as
+// every view's preparation does: double clip coordinates (raster::ortho_view_to_clip) and, when
+// `clip` is not empty (GL-exact), the floats every device draws (one rounding per coordinate,
+// gl_exact_clip_depth). False when the transform fails; the caller names the problem.
+[[nodiscard]] bool transform_to_clip(const raster::OrthoView& view, std::span<const raster::Double3> points,
+                                     std::span<raster::Double4> clip_d, std::span<raster::Float4> clip,
+                                     raster::RasterRules rules);
+
 // The checks every visibility method makes before drawing anything: option ranges, a valid scene,
 // `active` strictly increasing and in range, and every active object's coordinates inside the
 // exact range (with the ground truth's message, so all methods refuse alike). Returns the views'

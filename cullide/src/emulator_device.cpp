@@ -1,10 +1,7 @@
 // emulator_device.cpp: the built-in QueryDevice (emulator_device.h).
 #include "emulator_device.h"
 
-#include <algorithm>
-#include <array>
 #include <cstdint>
-#include <cstring>
 
 #include "parallel.h"
 #include "raster/command_batch.h"
@@ -25,8 +22,7 @@ Result<bool> EmulatorDevice::ensure_target(int width, int height, raster::DepthF
     target_.emplace(std::move(t).value());
     // A new target is created cleared to 1.0: nothing written yet.
     constexpr int side = raster::kExecuteTileSize;
-    tiles_x_ = (width + side - 1) / side;
-    written_tiles_.assign(static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>((height + side - 1) / side), 0);
+    written_tiles_.assign(static_cast<std::size_t>((width + side - 1) / side) * static_cast<std::size_t>((height + side - 1) / side), 0);
     return true;
 }
 
@@ -35,34 +31,12 @@ Status EmulatorDevice::clear(int width, int height, raster::DepthFormat format) 
     if (!created) return created.error();
     if (created.value()) return Status{};
     // Only the tiles where raster::execute ran a writing draw (ExecuteOptions::written_tiles) can
-    // differ from depth 1.0: restoring them gives the same buffer as a full clear. In parallel over
-    // rows of tiles (each task fills its own pixels).
-    const std::uint32_t one = raster::DepthTarget::encode_clear(1.0, format);
-    std::uint32_t* const values = target_->mutable_values().data();
-    constexpr int side = raster::kExecuteTileSize;
-    const std::size_t tiles_y = written_tiles_.size() / static_cast<std::size_t>(tiles_x_);
-    // Each tile row is copied from a row of clear values (memcpy: wide stores on any target, where
-    // the element loop of std::fill stored one value per instruction; 8.8% of a cylinders / cullide
-    // frame's instructions, callgrind).
-    std::array<std::uint32_t, side> ones;
-    ones.fill(one);
-    const auto clear_row = [&](std::size_t ty) {
-        for (int tx = 0; tx < tiles_x_; ++tx) {
-            std::uint8_t& flag = written_tiles_[ty * static_cast<std::size_t>(tiles_x_) + static_cast<std::size_t>(tx)];
-            if (flag == 0) continue;
-            flag = 0;
-            const int x0 = tx * side, x1 = std::min(width, x0 + side);
-            const int y0 = static_cast<int>(ty) * side, y1 = std::min(height, y0 + side);
-            for (int y = y0; y < y1; ++y) {
-                std::uint32_t* row = values + static_cast<std::size_t>(y) * static_cast<std::size_t>(width);
-                std::memcpy(row + x0, ones.data(), static_cast<std::size_t>(x1 - x0) * sizeof(std::uint32_t));
-            }
-        }
-    };
-    if (threads_ > 1 && tiles_y > 1)
-        parallel_chunks(threads_, tiles_y, clear_row);
-    else
-        for (std::size_t ty = 0; ty < tiles_y; ++ty) clear_row(ty);
+    // differ from depth 1.0: an empty batch with clear_depth restores exactly those, each in its own
+    // tile task, which gives the same buffer as a full clear.
+    raster::ExecuteOptions options = execute_options();
+    options.clear_depth = 1.0;
+    raster::Result<raster::QueryResults> r = raster::execute(*target_, raster::CommandBatch(width, height), options);
+    if (!r) return Error{"emulator device: " + r.error().message};
     return Status{};
 }
 

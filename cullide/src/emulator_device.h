@@ -51,11 +51,10 @@ class EmulatorDevice final : public QueryDevice {
 
     int threads_;
     std::optional<raster::DepthTarget> target_;
-    // Per 64 x 64 tile of the target (raster::kExecuteTileSize, row-major, tiles_x_ per row): 1 when
-    // a draw with the depth mask on was rasterized in it since the last clear (filled in by
-    // raster::execute, ExecuteOptions::written_tiles).
+    // Per 64 x 64 tile of the target (raster::kExecuteTileSize, row-major): 1 when a draw with the
+    // depth mask on was rasterized in it since the last clear (filled in by raster::execute,
+    // ExecuteOptions::written_tiles; a clear resets what it restores).
     std::vector<std::uint8_t> written_tiles_;
-    int tiles_x_ = 1;
 };
 
 }  // namespace cullide::detail

@@ -69,14 +69,6 @@ const char* name_of(E e, const std::pair<const char*, E> (&table)[N]) {
     return "?";
 }
 
-// The worker count a frame runs with: frames of at most kSerialFrameTriangles triangles on the
-// calling thread (their parallel loops would cost more than their work).
-int frame_threads(std::span<const Mesh> objects, int threads) {
-    std::uint64_t triangles = 0;
-    for (const Mesh& m : objects) triangles += m.triangles.size();
-    return triangles <= kSerialFrameTriangles ? 1 : threads;
-}
-
 // Objects whose box overlaps another object's box (all objects for BroadPhase::None).
 Result<std::vector<std::uint32_t>> broad_phase(std::span<const Mesh> objects, const RunOptions& o, FrameStats& st) {
     std::vector<std::uint32_t> active;
@@ -365,6 +357,12 @@ Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOption
     const bool all_objects = options.broadphase == BroadPhase::None || options.self;
     const bool checked_later =
         all_objects && (options.method == Method::Exact || options.method == Method::Auto);
+    // The frame's triangles, and its worker count: frames of at most kSerialFrameTriangles
+    // triangles run on the calling thread (their parallel loops would cost more than their work).
+    std::uint64_t triangles = 0;
+    for (const Mesh& m : objects) triangles += m.triangles.size();
+    RunOptions run = options;
+    if (triangles <= kSerialFrameTriangles) run.threads = 1;
     const auto check = [&]() -> Status {
         // validate_scene, then validate_exact_range (every method ends in the exact test: the same
         // range as the ground truth, for all of them; pipeline_fuzz found rcullide accepting a
@@ -373,7 +371,7 @@ Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOption
         // thread's time in a 2-thread rcullide cylinders frame, perf).
         const std::size_t n = objects.size();
         std::vector<Status> mesh_ok(n), range_ok(n);
-        detail::parallel_chunks(frame_threads(objects, options.threads), n, [&](std::size_t i) {
+        detail::parallel_chunks(run.threads, n, [&](std::size_t i) {
             mesh_ok[i] = validate_mesh(objects[i]);
             range_ok[i] = detail::validate_exact_range_of(objects[i], i);
         });
@@ -388,9 +386,7 @@ Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOption
         if (Status s = check(); !s) return s.error();
     FrameResult result;
     FrameStats& st = result.stats;
-    for (const Mesh& m : objects) st.triangles += m.triangles.size();
-    RunOptions run = options;
-    if (st.triangles <= kSerialFrameTriangles) run.threads = 1;
+    st.triangles = triangles;
 
     const auto bp_start = std::chrono::steady_clock::now();
     Result<std::vector<std::uint32_t>> active = broad_phase(objects, run, st);

@@ -126,14 +126,19 @@ Result<std::vector<std::uint8_t>> QueryDevice::recorded_quick_view(ViewSize size
             [&](std::size_t d) {
                 if (!(out[d] & other)) batch.draw(items[d].mesh, write_state);
             });
-        if (Status s = clear(size.width(), size.height(), format); !s) return s.error();
-        Result<raster::QueryResults> r = execute(batch);
-        if (!r) return r.error();
-        if (r.value().size() != batch.query_kinds().size())
-            return Error{name() + " returned " + std::to_string(r.value().size()) + " query results for " +
+        // On a cleared target through execute_cleared, as Quick-CULLIDE's recorded GL passes: the
+        // emulator then restores written tiles in their own tile tasks.
+        const raster::CommandBatch* const one[1] = {&batch};
+        Result<std::vector<raster::QueryResults>> run = execute_cleared(size.width(), size.height(), format, one);
+        if (!run) return run.error();
+        if (run.value().size() != 1)
+            return Error{name() + " returned " + std::to_string(run.value().size()) + " result lists for 1 batch"};
+        const raster::QueryResults& r = run.value()[0];
+        if (r.size() != batch.query_kinds().size())
+            return Error{name() + " returned " + std::to_string(r.size()) + " query results for " +
                          std::to_string(batch.query_kinds().size()) + " queries"};
         for (std::size_t k = 0; k < items.size(); ++k)
-            if (!(out[k] & proven) && r.value()[query[k]] == 0) out[k] |= proven;
+            if (!(out[k] & proven) && r[query[k]] == 0) out[k] |= proven;
     }
     return out;
 }

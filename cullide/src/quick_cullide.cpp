@@ -103,9 +103,9 @@ Status transform_geoms(std::vector<Geom>& geoms, const std::vector<char>& geom_l
     std::vector<std::size_t> live;
     for (std::size_t gi = 0; gi < geoms.size(); ++gi)
         if (geom_live[gi]) live.push_back(gi);
-    // Parts of kTransformPart positions per parallel job, each writing only its own part (one job
-    // per geometry left the second thread idle on one-object scenes such as the cloth).
-    constexpr std::size_t kTransformPart = 4096;
+    // Parts of detail::kTransformPart positions per parallel job, each writing only its own part
+    // of its geometry's clip arrays (one job per geometry left the second thread idle on
+    // one-object scenes such as the cloth).
     struct Part {
         std::size_t gi, b, e;
     };
@@ -115,22 +115,19 @@ Status transform_geoms(std::vector<Geom>& geoms, const std::vector<char>& geom_l
         const std::size_t n = g.positions.size();
         g.clip_d.resize(n);
         if (mode != VisibilityMode::ExactBounds) g.clip.resize(n);
-        for (std::size_t b = 0; b < n; b += kTransformPart) parts.push_back({gi, b, std::min(n, b + kTransformPart)});
+        for (std::size_t b = 0; b < n; b += detail::kTransformPart)
+            parts.push_back({gi, b, std::min(n, b + detail::kTransformPart)});
     }
     std::vector<char> ok(parts.size(), 0);
     detail::parallel_chunks(threads, parts.size(), [&](std::size_t j) {
         Geom& g = geoms[parts[j].gi];
-        const std::size_t b = parts[j].b, e = parts[j].e;
-        if (!raster::ortho_view_to_clip(view, std::span<const raster::Double3>(g.positions).subspan(b, e - b),
-                                        std::span<raster::Double4>(g.clip_d).subspan(b, e - b)))
-            return;
-        if (mode != VisibilityMode::ExactBounds) {
-            for (std::size_t i = b; i < e; ++i) {
-                const raster::Double4& d = g.clip_d[i];
-                g.clip[i] = {static_cast<float>(d.x), static_cast<float>(d.y), detail::gl_exact_clip_depth(d.z, rules), 1.0f};
-            }
-        }
-        ok[j] = 1;
+        const std::size_t b = parts[j].b, len = parts[j].e - parts[j].b;
+        const std::span<raster::Float4> clip = mode != VisibilityMode::ExactBounds
+                                                   ? std::span<raster::Float4>(g.clip).subspan(b, len)
+                                                   : std::span<raster::Float4>();
+        ok[j] = detail::transform_to_clip(view, std::span<const raster::Double3>(g.positions).subspan(b, len),
+                                          std::span<raster::Double4>(g.clip_d).subspan(b, len), clip, rules)
+                    ? 1 : 0;
     });
     for (std::size_t j = 0; j < parts.size(); ++j) {
         if (ok[j]) continue;

@@ -441,12 +441,9 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
     const auto clip_to_tile = [&](int bx0, int by0, int bx1, int by1) {
         return detail::PixelRect{std::max(x0, bx0), std::max(y0, by0), std::min(x1, bx1), std::min(y1, by1)};
     };
-    detail::HizTile* const hiz =
-        ctx.hiz ? &ctx.hiz_tiles[static_cast<std::size_t>(ty) * static_cast<std::size_t>((ctx.width + kTileSize - 1) / kTileSize) +
-                                 static_cast<std::size_t>(tx)]
-                : nullptr;
     const std::size_t tile_index = static_cast<std::size_t>(ty) * static_cast<std::size_t>((ctx.width + kTileSize - 1) / kTileSize) +
                                    static_cast<std::size_t>(tx);
+    detail::HizTile* const hiz = ctx.hiz ? &ctx.hiz_tiles[tile_index] : nullptr;
     if (ctx.clear_row != nullptr && (ctx.written_tiles == nullptr || ctx.written_tiles[tile_index] != 0)) {
         // Each row by memcpy from a row of clear values (wide stores on any target; the element
         // loop of std::fill stored one value per instruction: emulator_device.cpp).
