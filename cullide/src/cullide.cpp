@@ -66,13 +66,6 @@ struct ObjectGeometry {
 // Shared with quick_cullide.cpp (cullide_detail.h).
 namespace detail {
 
-Aabb unite(const Aabb& a, const Aabb& b) {
-    if (a.empty()) return b;
-    if (b.empty()) return a;
-    return {{std::min(a.lo.x, b.lo.x), std::min(a.lo.y, b.lo.y), std::min(a.lo.z, b.lo.z)},
-            {std::max(a.hi.x, b.hi.x), std::max(a.hi.y, b.hi.y), std::max(a.hi.z, b.hi.z)}};
-}
-
 // Grows [lo, hi] so that geometry on its faces stays inside the clip volume after the clip
 // coordinates are rounded to float (relative error 2^-24 of the unit range): 1/1024 of the extent
 // is far above that and costs 0.2% of the resolution. A flat extent gets a margin relative to the
@@ -146,17 +139,6 @@ std::uint64_t count_live(const std::vector<ObjectGeometry>& g) {
     return n;
 }
 
-std::uint64_t count_live_triangles(const std::vector<ObjectGeometry>& g) {
-    std::uint64_t n = 0;
-    for (const ObjectGeometry& og : g)
-        for (const Item& it : og.items) n += it.live ? it.index_count / 3 : 0;
-    return n;
-}
-
-bool has_live(const ObjectGeometry& og) {
-    return std::any_of(og.items.begin(), og.items.end(), [](const Item& it) { return it.live; });
-}
-
 // Draws one item as a query (GEQUAL, mask off) or a write (LEQUAL, mask on); returns the triangles
 // submitted.
 std::uint64_t draw_item(raster::CommandBatch& batch, const ObjectGeometry& og, const Item& it, CullStage stage,
@@ -207,53 +189,53 @@ void record_pass(raster::CommandBatch& batch, std::vector<ObjectGeometry>& g, co
     }
 }
 
-// The queries and triangles of the two passes record_pass would record for `order` (the fused pass
-// reports what it replaces): each live item is queried in both passes and written in both except
-// after each pass's last object (order.back() forward, order.front() backward), so with L live
-// items of T triangles in all, 2 L queries and 4 T - T(back) - T(front) triangles.
-void count_passes(const std::vector<ObjectGeometry>& g, const std::vector<std::size_t>& order, ViewStats& vs) {
-    const auto live_triangles = [&](std::size_t i) {
-        std::uint64_t t = 0;
-        for (const Item& it : g[i].items) t += it.live ? it.index_count / 3 : 0;
-        return t;
-    };
-    std::uint64_t live = 0, triangles = 0;
-    for (std::size_t i : order)
-        for (const Item& it : g[i].items) {
-            live += it.live ? 1 : 0;
-            triangles += it.live ? it.index_count / 3 : 0;
-        }
-    vs.queries += 2 * live;
-    vs.triangles_rasterized += 4 * triangles - live_triangles(order.back()) - live_triangles(order.front());
-}
+// What one view pruned: items and their triangles.
+struct Pruned {
+    std::uint64_t items = 0, triangles = 0;
+};
 
 // Both passes of one exact-bounds view as the device's visibility pass (query_device.h); prunes
 // the fully visible items. The fused and the recorded form give the same answers
 // (tests/cullide/fused_visibility_test.cpp compares the two).
-Result<std::uint64_t> visibility_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_t>& order,
-                                      const CullideOptions& o, ViewSize size, QueryDevice& device, ViewStats& vs) {
-    std::vector<raster::VisibilityItem> items;
-    std::vector<Item*> refs;
+Result<Pruned> visibility_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_t>& order,
+                               const CullideOptions& o, ViewSize size, QueryDevice& device, ViewStats& vs) {
+    // Kept per thread (capacity only), as the views of a frame follow one another.
+    thread_local std::vector<raster::VisibilityItem> items;
+    thread_local std::vector<Item*> refs;
+    items.clear();
+    refs.clear();
+    // The queries and triangles of the two passes record_pass would record for `order` (the fused
+    // pass reports what it replaces): each live item is queried in both passes and written in both
+    // except after each pass's last object (order.back() forward, order.front() backward), so with
+    // L live items of T triangles in all, 2 L queries and 4 T - T(back) - T(front) triangles.
+    std::uint64_t triangles = 0, first_triangles = 0, last_triangles = 0;
     for (std::size_t k = 0; k < order.size(); ++k) {
         ObjectGeometry& og = g[order[k]];
+        std::uint64_t object_triangles = 0;
         for (Item& it : og.items) {
             if (!it.live) continue;
             items.push_back({raster::MeshViewD{og.clip_d, std::span<const std::uint32_t>(og.indices)
                                                               .subspan(it.first_index, it.index_count)},
                              static_cast<std::uint32_t>(k)});
             refs.push_back(&it);
+            object_triangles += it.index_count / 3;
         }
+        triangles += object_triangles;
+        if (k == 0) first_triangles = object_triangles;
+        if (k + 1 == order.size()) last_triangles = object_triangles;
     }
-    count_passes(g, order, vs);
+    vs.queries += 2 * items.size();
+    vs.triangles_rasterized += 4 * triangles - last_triangles - first_triangles;
     Result<std::vector<std::uint8_t>> r = o.fused_visibility
                                               ? device.visibility_pass(size, o.depth_format, items)
                                               : device.recorded_visibility_pass(size, o.depth_format, items);
     if (!r) return r.error();
-    std::uint64_t pruned = 0;
+    Pruned pruned;
     for (std::size_t i = 0; i < refs.size(); ++i) {
         if (r.value()[i] == 0) {
             refs[i]->live = false;
-            ++pruned;
+            ++pruned.items;
+            pruned.triangles += refs[i]->index_count / 3;
         }
     }
     return pruned;
@@ -261,7 +243,7 @@ Result<std::uint64_t> visibility_view(std::vector<ObjectGeometry>& g, const std:
 
 // Both passes of one GL-exact or offset view, recorded and run on the device; prunes the fully
 // visible items.
-Result<std::uint64_t> recorded_view(std::vector<ObjectGeometry>& g, std::vector<std::size_t> order,
+Result<Pruned> recorded_view(std::vector<ObjectGeometry>& g, std::vector<std::size_t> order,
                                     const CullideOptions& o, ViewSize size, QueryDevice& device, ViewStats& vs) {
     // Both passes are recorded first and run as one sequence, each on a cleared target: a device
     // may share their work (the emulator sets each triangle up once for both).
@@ -282,12 +264,13 @@ Result<std::uint64_t> recorded_view(std::vector<ObjectGeometry>& g, std::vector<
         if (results[pass].size() != batches[pass].query_kinds().size())
             return Error{"device returned " + std::to_string(results[pass].size()) + " query results for " +
                          std::to_string(batches[pass].query_kinds().size()) + " queries"};
-    std::uint64_t pruned = 0;
+    Pruned pruned;
     for (std::size_t i : order) {
         for (Item& it : g[i].items) {
             if (it.live && results[0][it.query[0]] == 0 && results[1][it.query[1]] == 0) {
                 it.live = false;
-                ++pruned;
+                ++pruned.items;
+                pruned.triangles += it.index_count / 3;
             }
         }
     }
@@ -370,14 +353,23 @@ Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideO
     const double min_prune =
         o.min_prune >= 0.0 ? o.min_prune : o.mode == VisibilityMode::ExactBounds ? kDefaultMinPruneExactBounds : 0.0;
     int quiet = 0;
+    std::vector<std::size_t> order;
     for (int view = 0; view < 3 * o.max_rounds && quiet < 3; ++view) {
-        std::vector<std::size_t> order;
+        // One pass over the items: the objects with live items (order), the union of the live
+        // items' boxes, and how many items and triangles are live.
+        order.clear();
         Aabb bounds;
+        std::uint64_t items_before = 0, tris_before = 0;
         for (std::size_t i = 0; i < g.size(); ++i) {
-            if (!has_live(g[i])) continue;
-            order.push_back(i);
-            for (const Item& it : g[i].items)
-                if (it.live) bounds = unite(bounds, it.box);
+            bool any = false;
+            for (const Item& it : g[i].items) {
+                if (!it.live) continue;
+                any = true;
+                bounds = unite(bounds, it.box);
+                ++items_before;
+                tris_before += it.index_count / 3;
+            }
+            if (any) order.push_back(i);
         }
         if (order.size() < 2) {  // nothing left to collide with
             for (ObjectGeometry& og : g)
@@ -389,18 +381,17 @@ Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideO
         ViewStats vs;
         vs.stage = stage;
         vs.axis = axis;
-        vs.items_before = count_live(g);
-        const std::uint64_t tris_before = count_live_triangles(g);
-        Result<std::uint64_t> pruned = o.mode == VisibilityMode::ExactBounds
-                                           ? visibility_view(g, order, o, size, device, vs)
-                                           : recorded_view(g, order, o, size, device, vs);
+        vs.items_before = items_before;
+        Result<Pruned> pruned = o.mode == VisibilityMode::ExactBounds
+                                    ? visibility_view(g, order, o, size, device, vs)
+                                    : recorded_view(g, order, o, size, device, vs);
         if (!pruned) return pruned.error();
-        vs.items_after = vs.items_before - pruned.value();
+        vs.items_after = vs.items_before - pruned.value().items;
         st.queries += vs.queries;
         st.triangles_rasterized += vs.triangles_rasterized;
         st.views.push_back(vs);
         // Unproductive: pruned fewer triangles than min_prune of those live (none pruned: always).
-        const std::uint64_t pruned_tris = tris_before - count_live_triangles(g);
+        const std::uint64_t pruned_tris = pruned.value().triangles;
         const bool unproductive =
             pruned_tris == 0 || static_cast<double>(pruned_tris) < min_prune * static_cast<double>(tris_before);
         quiet = unproductive ? quiet + 1 : 0;

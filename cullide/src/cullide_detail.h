@@ -1,6 +1,7 @@
 // cullide_detail.h (private): view helpers of cullide.cpp shared with quick_cullide.cpp.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -12,8 +13,14 @@
 
 namespace cullide::detail {
 
-// The smallest box holding both (an empty box is the identity).
-[[nodiscard]] Aabb unite(const Aabb& a, const Aabb& b);
+// The smallest box holding both (an empty box is the identity). Inline: the views unite every live
+// item's box, thousands per view.
+[[nodiscard]] inline Aabb unite(const Aabb& a, const Aabb& b) {
+    if (a.empty()) return b;
+    if (b.empty()) return a;
+    return {{std::min(a.lo.x, b.lo.x), std::min(a.lo.y, b.lo.y), std::min(a.lo.z, b.lo.z)},
+            {std::max(a.hi.x, b.hi.x), std::max(a.hi.y, b.hi.y), std::max(a.hi.z, b.hi.z)}};
+}
 // Grows [lo, hi] by a margin that keeps geometry on its faces inside the clip volume after the
 // clip coordinates are rounded to float.
 void widen(double& lo, double& hi);
