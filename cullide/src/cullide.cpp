@@ -456,19 +456,22 @@ std::vector<ObjectGeometry> box_geometry(std::span<const Mesh> objects, std::spa
 
 // Stage 2's geometry: the mesh of each object whose box survived, as one item.
 std::vector<ObjectGeometry> object_geometry(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
-                                            const std::vector<ObjectGeometry>& boxes) {
-    std::vector<ObjectGeometry> whole;
-    for (const ObjectGeometry& b : boxes) {
-        if (!b.items[0].live) continue;
+                                            const std::vector<ObjectGeometry>& boxes, int threads) {
+    std::vector<const ObjectGeometry*> live;
+    for (const ObjectGeometry& b : boxes)
+        if (b.items[0].live) live.push_back(&b);
+    std::vector<ObjectGeometry> whole(live.size());
+    detail::parallel_chunks(threads, live.size(), [&](std::size_t k) {  // each fills its own geometry
+        const ObjectGeometry& b = *live[k];
         const Mesh& m = objects[active[b.active_index]];
-        ObjectGeometry og;
+        ObjectGeometry& og = whole[k];
         og.active_index = b.active_index;
         og.positions = to_double3(m);
-        og.indices.reserve(m.triangles.size() * 3);
-        for (const Tri& t : m.triangles) og.indices.insert(og.indices.end(), t.begin(), t.end());
+        og.indices.resize(m.triangles.size() * 3);
+        for (std::size_t t = 0; t < m.triangles.size(); ++t)
+            std::copy(m.triangles[t].begin(), m.triangles[t].end(), og.indices.begin() + static_cast<std::ptrdiff_t>(3 * t));
         og.items.push_back({0, static_cast<std::uint32_t>(og.indices.size()), b.items[0].box, true, {}});
-        whole.push_back(std::move(og));
-    }
+    });
     return whole;
 }
 
@@ -490,12 +493,15 @@ std::vector<ObjectGeometry> subobject_geometry(std::span<const Mesh> objects, st
     };
     std::vector<Part> parts;
     for (std::size_t k = 0; k < subs.size(); ++k) {
+        const std::size_t n = objects[active[subs[k].active_index]].triangles.size();
+        for (std::size_t first = 0; first < n; first += per_part) parts.push_back({k, first, std::min(n, first + per_part)});
+    }
+    detail::parallel_chunks(threads, subs.size(), [&](std::size_t k) {  // sized per object, in parallel too
         ObjectGeometry& og = subs[k];
         const std::size_t n = objects[active[og.active_index]].triangles.size();
         og.triangle_boxes.resize(n);
-        og.items.assign((n + group - 1) / group, Item{});
-        for (std::size_t first = 0; first < n; first += per_part) parts.push_back({k, first, std::min(n, first + per_part)});
-    }
+        og.items.resize((n + group - 1) / group);
+    });
     detail::parallel_chunks(threads, parts.size(), [&](std::size_t j) {
         ObjectGeometry& og = subs[parts[j].k];
         const Mesh& m = objects[active[og.active_index]];
@@ -529,7 +535,7 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
     st.boxes_ms = ms_since(t0);
 
     t0 = Clock::now();
-    std::vector<ObjectGeometry> whole = object_geometry(objects, active, boxes);
+    std::vector<ObjectGeometry> whole = object_geometry(objects, active, boxes, options.threads);
     const bool object_stage = options.object_stage == ObjectStage::On ||
                               (options.object_stage == ObjectStage::Auto && options.mode != VisibilityMode::ExactBounds);
     if (object_stage)
