@@ -5,10 +5,8 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <string>
 
-#include "cullide/predicates.h"
 #include "cullide_detail.h"
 #include "exact_stage.h"
 #include "parallel.h"
@@ -576,7 +574,21 @@ Result<ViewSize> check_visibility_inputs(std::span<const Mesh> objects, std::spa
         return Error{"gpu rules: unknown value " + std::to_string(static_cast<int>(o.gpu_rules))};
     if (mode == VisibilityMode::Offset && o.gpu_rules != raster::RasterRules::GlLlvmpipe)
         return Error{"the offset mode (R-CULLIDE's offset solids) is built for the GL rules only; use --gpu-rules gl"};
-    if (Status s = validate_scene(objects); !s) return s.error();
+    // Each object's scan in its own parallel job (they were serial work on the calling thread of
+    // every frame); the problems are then reported in the order of the serial checks, so the same
+    // first one is named.
+    std::vector<Status> mesh_ok(objects.size()), range_ok(active.size());
+    detail::parallel_chunks(o.threads, objects.size() + active.size(), [&](std::size_t j) {
+        if (j < objects.size()) {
+            mesh_ok[j] = validate_mesh(objects[j]);
+            return;
+        }
+        const std::size_t k = j - objects.size();
+        if (active[k] < objects.size())  // (beyond: reported below)
+            range_ok[k] = detail::validate_exact_range_of(objects[active[k]], active[k]);
+    });
+    for (std::size_t i = 0; i < objects.size(); ++i)  // validate_scene's first problem
+        if (!mesh_ok[i]) return Error{"object " + std::to_string(i) + ": " + mesh_ok[i].error().message};
     if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
     for (std::size_t k = 0; k < active.size(); ++k) {
         if (active[k] >= objects.size())
@@ -587,17 +599,7 @@ Result<ViewSize> check_visibility_inputs(std::span<const Mesh> objects, std::spa
         const Mesh& m = objects[active[k]];
         if (m.triangles.size() > UINT32_MAX / 3)
             return Error{"object " + std::to_string(active[k]) + ": too many triangles (limit 2^32 / 3)"};
-        for (std::size_t v = 0; v < m.positions.size(); ++v) {
-            for (int c = 0; c < 3; ++c) {
-                if (!predicate_coordinate_ok(m.positions[v][c])) {
-                    char value[32];
-                    std::snprintf(value, sizeof value, "%.17g", m.positions[v][c]);
-                    return Error{"object " + std::to_string(active[k]) + ": mesh '" + m.name + "': vertex " +
-                                 std::to_string(v) + " coordinate " + "xyz"[c] + " = " + value +
-                                 " is outside the exact range (0, or 2^-300 <= |x| <= 2^300)"};
-                }
-            }
-        }
+        if (!range_ok[k]) return range_ok[k].error();
     }
     return size;
 }

@@ -12,6 +12,7 @@
 #include "cullide/cullide.h"
 #include "cullide/ground_truth.h"
 #include "cullide/pipeline.h"
+#include "cullide/quick_cullide.h"
 #include "cullide/scenes.h"
 #include "pipeline_test_util.h"
 
@@ -394,6 +395,79 @@ TEST_CASE("every method names the first problem the serial scene checks name (ex
                     REQUIRE_FALSE(r.ok());
                     CHECK(r.error().message == serial.error().message);
                 }
+    }
+}
+
+TEST_CASE("cullide_pairs and quick_cullide_pairs name the first problem the serial scene checks name") {
+    // Both check their own inputs (the public entry points), each object in its own parallel job
+    // (session 12): validate_scene's first problem, then the active list's, then the exact range's,
+    // in that order, whatever the thread count.
+    const auto scene = [] {
+        std::vector<cullide::Mesh> objects;
+        for (int o = 0; o < 6; ++o) objects.push_back(cube({0.4 * o, 0, 0}, 1.0, std::string("c").append(std::to_string(o))));
+        return objects;
+    };
+    struct Case {
+        const char* what;
+        std::vector<cullide::Mesh> objects;
+        std::vector<std::uint32_t> active;
+        const char* must_name;
+    };
+    const std::vector<std::uint32_t> all{0, 1, 2, 3, 4, 5};
+    std::vector<Case> cases;
+    {
+        auto s = scene();  // a range problem in object 1, an index problem in object 2: the index first
+        s[1].positions[3].y = 0x1p-310;
+        s[2].triangles[5][2] = 8;
+        cases.push_back({"index after range", std::move(s), all, "object 2: mesh 'c2': triangle 5 vertex index 8"});
+    }
+    {
+        auto s = scene();  // range problems in objects 1 and 3: object 1's
+        s[3].positions[0].x = 0x1p301;
+        s[1].positions[7].z = -0x1p-1070;
+        cases.push_back({"two range problems", std::move(s), all, "object 1: mesh 'c1': vertex 7 coordinate z"});
+    }
+    {
+        auto s = scene();  // object 1 is not active: object 3's range problem
+        s[3].positions[0].x = 0x1p301;
+        s[1].positions[7].z = -0x1p-1070;
+        cases.push_back({"inactive object's range", std::move(s), {0, 2, 3, 5}, "object 3: mesh 'c3': vertex 0 coordinate x"});
+    }
+    {
+        auto s = scene();  // a range problem at entry 1, an unsorted active list from entry 2: the range first
+        s[2].positions[1].x = 0x1p-1000;
+        cases.push_back({"range before unsorted", std::move(s), {0, 2, 1}, "object 2: mesh 'c2': vertex 1 coordinate x"});
+    }
+    {
+        auto s = scene();  // an unsorted list at entry 1, a range problem at entry 2: the list first
+        s[3].positions[1].x = 0x1p-1000;
+        cases.push_back({"unsorted before range", std::move(s), {2, 1, 3}, "strictly increasing (entry 1)"});
+    }
+    {
+        auto s = scene();  // a NaN in object 4 (inactive) and a range problem in object 0: the NaN
+        s[4].positions[2].x = std::nan("");
+        s[0].positions[0].y = 0x1p-400;
+        cases.push_back({"non-finite anywhere first", std::move(s), {0, 1}, "object 4: mesh 'c4': vertex 2 has a non-finite"});
+    }
+    for (const Case& c : cases) {
+        CAPTURE(c.what);
+        for (int threads : {1, 2, 3}) {
+            CAPTURE(threads);
+            auto device = cullide::make_emulator_device(threads);
+            cullide::CullideOptions co;
+            co.mode = cullide::VisibilityMode::ExactBounds;
+            co.resolution = 32;
+            co.threads = threads;
+            auto p = cullide::cullide_pairs(c.objects, c.active, co, *device);
+            REQUIRE_FALSE(p.ok());
+            CHECK(p.error().message.find(c.must_name) != std::string::npos);
+            cullide::QuickOptions qo;
+            qo.resolution = 32;
+            qo.threads = threads;
+            auto q = cullide::quick_cullide_pairs(c.objects, c.active, qo, *device);
+            REQUIRE_FALSE(q.ok());
+            CHECK(q.error().message == p.error().message);
+        }
     }
 }
 
