@@ -158,12 +158,13 @@ void classify_bounds_triangle(BoundsTri& t, const BoundsVertex* win, int n, doub
 
 void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const Double4& b, const Double4& c,
                            std::uint32_t draw, std::vector<BoundsTri>& out, std::vector<BoundsVertex>& pool) {
-    // M: the magnitude that scales every clip-space rounding error of this triangle.
-    // (Straight-line code for the three vertices: the same maxima and minima as loops, which the
-    // compiler does not unroll; no value is NaN, and the sign of a zero does not reach any result.)
-    const double mag = std::max(std::max(std::max(std::max(1.0, std::fabs(a.x)), std::max(std::fabs(a.y), std::fabs(a.z))),
-                                         std::max(std::max(std::fabs(b.x), std::fabs(b.y)), std::fabs(b.z))),
-                                std::max(std::max(std::fabs(c.x), std::fabs(c.y)), std::fabs(c.z)));
+    // M = max(1, every |coordinate|): the magnitude that scales every clip-space rounding error of
+    // this triangle. (Straight-line code for the three vertices: the same maxima as a loop, which
+    // the compiler does not unroll; no value is NaN.)
+    const double absmax = std::max(std::max(std::max(std::max(std::fabs(a.x), std::fabs(a.y)), std::fabs(a.z)),
+                                            std::max(std::max(std::fabs(b.x), std::fabs(b.y)), std::fabs(b.z))),
+                                   std::max(std::max(std::fabs(c.x), std::fabs(c.y)), std::fabs(c.z)));
+    const double mag = std::max(1.0, absmax);
     const double mc = mag * kClipMarginRel;
     const double lim = 1.0 + mc;
 
@@ -177,13 +178,11 @@ void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const
     int n = 3;
     BoundsP3* cur = buf_a;
     BoundsP3* nxt = buf_b;
-    // Trivial accept: a clip that keeps every vertex returns the triangle unchanged (mag >= every
-    // |coordinate|, so only lim's rounding could matter, and the test is the clip's own d >= 0).
-    // (lim - v >= 0 iff v <= lim and lim + v >= 0 iff v >= -lim: the signs of the rounded
-    // differences are the exact ones.)
-    const double cmax = std::max(std::max(std::max(std::max(a.x, a.y), std::max(a.z, b.x)), std::max(std::max(b.y, b.z), std::max(c.x, c.y))), c.z);
-    const double cmin = std::min(std::min(std::min(std::min(a.x, a.y), std::min(a.z, b.x)), std::min(std::min(b.y, b.z), std::min(c.x, c.y))), c.z);
-    const bool inside = cmax <= lim && cmin >= -lim;
+    // Trivial accept: a clip that keeps every vertex returns the triangle unchanged, and it keeps
+    // them all iff every coordinate v has lim - v >= 0 and lim + v >= 0 (the clip's own d >= 0; the
+    // signs of those rounded differences are the exact ones), i.e. iff every |v| <= lim: one
+    // compare of the largest |v|, which M needs anyway.
+    const bool inside = absmax <= lim;
     for (int axis = 0; axis < 3 && n > 0 && !inside; ++axis) {
         for (double s : {1.0, -1.0}) {
             n = bounds_clip_axis(cur, n, nxt, axis, s, lim);
