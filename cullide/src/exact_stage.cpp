@@ -171,9 +171,15 @@ GridAxis make_grid_axis(std::span<const SweepRef> refs, const Aabb& bounds, int 
     return g;
 }
 
+// Refs per binning job of a big task (bin_task, TaskBuilder::make_task).
+constexpr std::size_t kBinChunk = 8192;
+
 // Bins `refs` (the first `first_count` are the first object's) into the grid over `bounds`: count,
-// scan, fill, so each cell holds each side's refs as one run.
-void bin_task(Task& task, const std::vector<SweepRef>& refs, std::size_t first_count, const Aabb& bounds) {
+// scan, fill, so each cell holds each side's refs as one run, in ref order. A big task (a bunny
+// inside a dragon: one task, tens of thousands of refs) counts and fills in chunks of refs on up to
+// `threads` workers: each chunk's refs go after the earlier chunks' in every cell, so the order, and
+// everything swept from it, is the serial one whatever the chunks.
+void bin_task(Task& task, const std::vector<SweepRef>& refs, std::size_t first_count, const Aabb& bounds, int threads) {
     const int u = (task.axis + 1) % 3, v = (task.axis + 2) % 3;
     const std::size_t budget = std::max<std::size_t>(1, refs.size() / kRefsPerCell);
     GridAxis gu = make_grid_axis(refs, bounds, u, static_cast<int>(std::min<std::size_t>(budget, kMaxCellsPerAxis)));
@@ -182,38 +188,55 @@ void bin_task(Task& task, const std::vector<SweepRef>& refs, std::size_t first_c
     task.grid_u = gu.cells;
     task.grid_v = gv.cells;
     const std::size_t cells = static_cast<std::size_t>(gu.cells) * static_cast<std::size_t>(gv.cells);
+    const std::size_t slots = 2 * cells;  // slot 2 * c + side: the refs of one side in cell c
     struct Span {
         std::uint32_t u0, u1, v0, v1;
     };
     std::vector<Span> spans(refs.size());
-    // counts[2 * c + side]: refs of each side per cell.
-    std::vector<std::uint32_t> counts(2 * cells + 1, 0);
-    for (std::size_t i = 0; i < refs.size(); ++i) {
-        const Aabb& b = refs[i].box;
-        spans[i] = {gu.cell(b.lo[u]), gu.cell(b.hi[u]), gv.cell(b.lo[v]), gv.cell(b.hi[v])};
-        const std::size_t side = i < first_count ? 0 : 1;
-        for (std::uint32_t cv = spans[i].v0; cv <= spans[i].v1; ++cv)
-            for (std::uint32_t cu = spans[i].u0; cu <= spans[i].u1; ++cu) ++counts[2 * (cv * gu.cells + cu) + side];
-    }
-    std::vector<std::uint32_t> next(2 * cells + 1, 0);
-    for (std::size_t k = 0; k < 2 * cells; ++k) next[k + 1] = next[k] + counts[k];
+    const std::size_t chunks =
+        std::min<std::size_t>((refs.size() + kBinChunk - 1) / kBinChunk, 4 * static_cast<std::size_t>(effective_threads(threads)));
+    const std::size_t per_chunk = chunks > 0 ? (refs.size() + chunks - 1) / chunks : 0;
+    // at[chunk * slots + k]: chunk's count in slot k, then (after the scan) where it writes there.
+    std::vector<std::uint32_t> at(chunks * slots, 0);
+    const auto chunk_range = [&](std::size_t ch) {
+        return std::pair{ch * per_chunk, std::min(refs.size(), (ch + 1) * per_chunk)};
+    };
+    parallel_chunks(chunks > 1 ? threads : 1, chunks, [&](std::size_t ch) {
+        std::uint32_t* counts = at.data() + ch * slots;
+        const auto [b, e] = chunk_range(ch);
+        for (std::size_t i = b; i < e; ++i) {
+            const Aabb& box = refs[i].box;
+            spans[i] = {gu.cell(box.lo[u]), gu.cell(box.hi[u]), gv.cell(box.lo[v]), gv.cell(box.hi[v])};
+            const std::size_t side = i < first_count ? 0 : 1;
+            for (std::uint32_t cv = spans[i].v0; cv <= spans[i].v1; ++cv)
+                for (std::uint32_t cu = spans[i].u0; cu <= spans[i].u1; ++cu) ++counts[2 * (cv * gu.cells + cu) + side];
+        }
+    });
     task.cell_begin.resize(cells + 1);
     task.cell_split.resize(cells);
-    for (std::size_t c = 0; c < cells; ++c) {
-        task.cell_begin[c] = next[2 * c];
-        task.cell_split[c] = next[2 * c + 1];
-    }
-    task.cell_begin[cells] = next[2 * cells];
-    task.refs.resize(next[2 * cells]);
-    for (std::size_t i = 0; i < refs.size(); ++i) {
-        const std::size_t side = i < first_count ? 0 : 1;
-        const std::uint32_t low = spans[i].u0 | (spans[i].v0 << 16);
-        for (std::uint32_t cv = spans[i].v0; cv <= spans[i].v1; ++cv) {
-            for (std::uint32_t cu = spans[i].u0; cu <= spans[i].u1; ++cu) {
-                task.refs[next[2 * (cv * gu.cells + cu) + side]++] = {refs[i], low};
-            }
+    std::uint32_t next = 0;
+    for (std::size_t k = 0; k < slots; ++k) {
+        if (k % 2 == 0) task.cell_begin[k / 2] = next;
+        else task.cell_split[k / 2] = next;
+        for (std::size_t ch = 0; ch < chunks; ++ch) {
+            const std::uint32_t c = at[ch * slots + k];
+            at[ch * slots + k] = next;
+            next += c;
         }
     }
+    task.cell_begin[cells] = next;
+    task.refs.resize(next);
+    parallel_chunks(chunks > 1 ? threads : 1, chunks, [&](std::size_t ch) {
+        std::uint32_t* pos = at.data() + ch * slots;
+        const auto [b, e] = chunk_range(ch);
+        for (std::size_t i = b; i < e; ++i) {
+            const std::size_t side = i < first_count ? 0 : 1;
+            const std::uint32_t low = spans[i].u0 | (spans[i].v0 << 16);
+            for (std::uint32_t cv = spans[i].v0; cv <= spans[i].v1; ++cv)
+                for (std::uint32_t cu = spans[i].u0; cu <= spans[i].u1; ++cu)
+                    task.refs[pos[2 * (cv * gu.cells + cu) + side]++] = {refs[i], low};
+        }
+    });
 }
 
 // Whether cell (cu, cv) holds the low corner of the intersection of boxes with low cells a and b.
@@ -323,12 +346,19 @@ class TaskBuilder {
 
     // The tasks added, in the order added; made on up to `threads` workers (binning a task is the
     // stage's largest serial cost otherwise).
+    // With fewer tasks than workers (a bunny inside a dragon: one), each task is made in turn with
+    // every worker (make_task's chunks); otherwise one task per job.
     std::vector<Task> take_tasks(int threads) {
         std::vector<Task> tasks(pending_.size());
-        parallel_chunks(threads, pending_.size(), [&](std::size_t t) {
+        const auto make = [&](std::size_t t, int inner) {
             PendingTask& p = pending_[t];
-            tasks[t] = make_task(std::move(p.refs), p.first_count, p.self ? nullptr : &p.common);
-        });
+            tasks[t] = make_task(std::move(p.refs), p.first_count, p.self ? nullptr : &p.common, inner);
+        };
+        if (pending_.size() < static_cast<std::size_t>(effective_threads(threads))) {
+            for (std::size_t t = 0; t < pending_.size(); ++t) make(t, threads);
+        } else {
+            parallel_chunks(threads, pending_.size(), [&](std::size_t t) { make(t, 1); });
+        }
         pending_.clear();
         return tasks;
     }
@@ -355,20 +385,41 @@ class TaskBuilder {
     // Chooses the axis, replaces loose sets by their triangles inside the common box and bins the
     // refs (bin_task). A self task (no common box) always sweeps triangles: a set's own pairs are
     // pairs of its triangles. Reads only the builder's inputs, so tasks are made concurrently.
-    Task make_task(std::vector<SweepRef>&& refs, std::size_t first_count, const Aabb* common) const {
+    Task make_task(std::vector<SweepRef>&& refs, std::size_t first_count, const Aabb* common, int threads) const {
         Task task;
         task.self = common == nullptr;
         task.axis = spread_axis(refs);
         const bool all_triangles =
             std::all_of(refs.begin(), refs.end(), [](const SweepRef& r) { return r.part != kWholeSet; });
         if (!all_triangles && (common == nullptr || loose(refs, task.axis))) {
-            std::vector<SweepRef> tris;
-            for (const SweepRef& r : refs) {
-                const CandidateSet& set = sets_[r.set];
+            // Each set's triangles inside the common box, in ref order: counted per ref, then
+            // written at the counted offsets, in chunks of refs on up to `threads` workers.
+            const std::size_t n = refs.size();
+            std::vector<std::size_t> at(n + 1, 0);
+            const auto each_triangle = [&](std::size_t r, auto&& f) {
+                const CandidateSet& set = sets_[refs[r].set];
                 const std::span<const Aabb> boxes = objects_[set.object].triangle_boxes;
                 for (std::uint32_t p = set.first; p < set.first + set.count; ++p)
-                    if (common == nullptr || overlaps(boxes[p], *common)) tris.push_back({boxes[p], set.object, r.set, p});
-            }
+                    if (common == nullptr || overlaps(boxes[p], *common)) f(SweepRef{boxes[p], set.object, refs[r].set, p});
+            };
+            constexpr std::size_t kSetChunk = 1024;
+            const std::size_t chunks = (n + kSetChunk - 1) / kSetChunk;
+            const int inner = chunks > 1 ? threads : 1;
+            parallel_chunks(inner, chunks, [&](std::size_t c) {
+                for (std::size_t r = c * kSetChunk; r < std::min(n, (c + 1) * kSetChunk); ++r) {
+                    std::size_t count = 0;
+                    each_triangle(r, [&](const SweepRef&) { ++count; });
+                    at[r + 1] = count;
+                }
+            });
+            for (std::size_t r = 0; r < n; ++r) at[r + 1] += at[r];
+            std::vector<SweepRef> tris(at[n]);
+            parallel_chunks(inner, chunks, [&](std::size_t c) {
+                for (std::size_t r = c * kSetChunk; r < std::min(n, (c + 1) * kSetChunk); ++r) {
+                    std::size_t w = at[r];
+                    each_triangle(r, [&](const SweepRef& t) { tris[w++] = t; });
+                }
+            });
             refs = std::move(tris);  // still object by object
             if (common != nullptr)
                 first_count = static_cast<std::size_t>(
@@ -383,7 +434,7 @@ class TaskBuilder {
                     bounds.lo[k] = std::min(bounds.lo[k], r.box.lo[k]);
                     bounds.hi[k] = std::max(bounds.hi[k], r.box.hi[k]);
                 }
-        bin_task(task, refs, first_count, bounds);
+        bin_task(task, refs, first_count, bounds, threads);
         return task;
     }
 

@@ -370,6 +370,59 @@ TEST_CASE("a big object in many pair tasks (walked in spatial order) gives the s
     }
 }
 
+TEST_CASE("one big pair task, made in chunks on several workers, gives the serial task's pairs and counts") {
+    // Two soups of 12,000 small triangles each over one box, in sets of 4 scattered triangles (so
+    // every set is loose and make_task sweeps its triangles): one pair task, fewer tasks than
+    // workers, so make_task expands the 6,000 sets in chunks of kSetChunk and bin_task bins the
+    // ~24,000 triangles in chunks of kBinChunk refs (session 12: the serial make_task was a fifth of
+    // an R-CULLIDE bunny-dragon frame at 2 threads). Every thread count (and so chunk count) must
+    // give the 1-thread pairs and counts, and the pairs must be the ground truth's (its own sweep).
+    test::Rng rng(77);
+    std::vector<Mesh> scene(2);
+    std::vector<std::vector<cullide::Aabb>> boxes(2);
+    for (std::uint32_t o = 0; o < 2; ++o) {
+        Mesh& m = scene[o];
+        m.name = "soup" + std::to_string(o);
+        for (std::uint32_t t = 0; t < 12000; ++t) {
+            const Vec3 c{rng.grid(0, 10, 64), rng.grid(0, 10, 64), rng.grid(0, 10, 64)};
+            for (int k = 0; k < 3; ++k)
+                m.positions.push_back(c + Vec3{rng.grid(-0.15, 0.15, 64), rng.grid(-0.15, 0.15, 64), rng.grid(-0.15, 0.15, 64)});
+            m.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
+            boxes[o].push_back(cullide::triangle_bounds(m, t));
+        }
+    }
+    std::vector<cullide::detail::ExactObject> exact(2);
+    std::vector<cullide::detail::CandidateSet> sets;
+    for (std::uint32_t o = 0; o < 2; ++o) {
+        exact[o] = {&scene[o], o, cullide::mesh_bounds(scene[o]), boxes[o], {}, {}};
+        for (std::uint32_t first = 0; first < 12000; first += 4) {
+            cullide::Aabb b = boxes[o][first];
+            for (std::uint32_t t = first + 1; t < first + 4; ++t)
+                for (int k = 0; k < 3; ++k) {
+                    b.lo[k] = std::min(b.lo[k], boxes[o][t].lo[k]);
+                    b.hi[k] = std::max(b.hi[k], boxes[o][t].hi[k]);
+                }
+            sets.push_back({o, first, 4, b});
+        }
+    }
+    const cullide::detail::ExactStageResult one = cullide::detail::sweep_exact_stage(exact, sets, {false, true, 1});
+    CHECK(one.stats.task_triangles == 24000);  // every set meets the common box
+    CHECK(one.stats.tests > 2000);
+    CHECK(one.pairs.size() > 100);
+    const auto truth = cullide::exact_pairs(scene, {false, 2});
+    REQUIRE(truth.ok());
+    CHECK(one.pairs == truth.value());
+    for (int threads : {2, 3, 8}) {
+        CAPTURE(threads);
+        const cullide::detail::ExactStageResult r = cullide::detail::sweep_exact_stage(exact, sets, {false, true, threads});
+        CHECK(r.pairs == one.pairs);
+        CHECK(r.stats.tests == one.stats.tests);
+        CHECK(r.stats.set_pairs == one.stats.set_pairs);
+        CHECK(r.stats.task_triangles == one.stats.task_triangles);
+        CHECK(r.stats.adjacent_skipped == one.stats.adjacent_skipped);
+    }
+}
+
 TEST_CASE("overlapping_sets gives the sorted multiset of overlapping set pairs of a brute-force double loop") {
     test::Rng rng(777);
     std::size_t total_pairs = 0;
