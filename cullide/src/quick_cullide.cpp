@@ -176,21 +176,25 @@ Result<std::uint64_t> run_pass(const std::vector<Geom>& geoms, std::vector<Item>
 }
 
 // The queries and triangles one recorded pass would submit with these tags (run_pass's counts; the
-// native view reports what it replaces).
+// native view reports what it replaces), in closed form: detail::quick_pass_schedule queries every
+// item once and, the windows being non-decreasing (the device checked them), writes exactly the
+// items whose window ends before the pass's last query: near_hi <= n - 2 forward, near_lo >= 1
+// backward (tests/cullide/quick_cullide_test.cpp compares every view's counts with the recorded
+// passes', which run the schedule).
 void count_pass(const std::vector<Item>& items, const std::vector<std::uint8_t>& tags, bool forward, ViewStats& vs) {
     const std::uint8_t proven = forward ? kFFV : kSFV;
     const std::uint8_t other = forward ? kSFV : kFFV;
-    detail::quick_pass_schedule(
-        items.size(), forward, [&](std::size_t k) { return items[k].near_lo; },
-        [&](std::size_t k) { return items[k].near_hi; },
-        [&](std::size_t k) {
-            if (tags[k] & proven) return;
-            ++vs.queries;
-            vs.triangles_rasterized += items[k].count;
-        },
-        [&](std::size_t d) {
-            if (!(tags[d] & other)) vs.triangles_rasterized += items[d].count;
-        });
+    const std::size_t n = items.size();
+    std::uint64_t queries = 0, triangles = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+        const Item& it = items[k];
+        const bool queried = !(tags[k] & proven);
+        const bool written = !(tags[k] & other) && (forward ? std::size_t{it.near_hi} + 2 <= n : it.near_lo >= 1);
+        queries += queried ? 1 : 0;
+        triangles += (queried ? it.count : 0) + (written ? it.count : 0);
+    }
+    vs.queries += queries;
+    vs.triangles_rasterized += triangles;
 }
 
 // Both passes of one exact-bounds view as the device's quick_view (query_device.h: natively on the
@@ -203,9 +207,10 @@ Result<std::uint64_t> native_view(const std::vector<Geom>& geoms, std::vector<It
     for (std::size_t i = 0; i < items.size(); ++i) {
         const Item& it = items[i];
         const Geom& g = geoms[it.geom];
+        // `used` as the device sets it (query_device.h): not an item proven apart both ways.
         wi[i] = {raster::MeshViewD{g.clip_d, std::span<const std::uint32_t>(g.indices)
                                                  .subspan(std::size_t{it.first} * 3, std::size_t{it.count} * 3)},
-                 it.near_lo, it.near_hi};
+                 it.near_lo, it.near_hi, (it.tag & (kFFV | kSFV)) != (kFFV | kSFV)};
         tags[i] = it.tag;
     }
     Result<std::vector<std::uint8_t>> r = device.quick_view(size, o.depth_format, wi, tags);
