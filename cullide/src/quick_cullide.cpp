@@ -175,26 +175,19 @@ Result<std::uint64_t> run_pass(const std::vector<Geom>& geoms, std::vector<Item>
     return changed;
 }
 
-// The queries and triangles one recorded pass would submit with these tags (run_pass's counts; the
-// native view reports what it replaces), in closed form: detail::quick_pass_schedule queries every
-// item once and, the windows being non-decreasing (the device checked them), writes exactly the
-// items whose window ends before the pass's last query: near_hi <= n - 2 forward, near_lo >= 1
-// backward (tests/cullide/quick_cullide_test.cpp compares every view's counts with the recorded
-// passes', which run the schedule).
-void count_pass(const std::vector<Item>& items, const std::vector<std::uint8_t>& tags, bool forward, ViewStats& vs) {
+// What one recorded pass (run_pass) would submit of item `it` (of n) with tag `tag`, the native
+// view reporting what it replaces: (1 if queried) + 4 * (its draws: the query's and the write's),
+// in closed form: detail::quick_pass_schedule queries every item once and, the windows being
+// non-decreasing (the device checked them), writes exactly the items whose window ends before the
+// pass's last query: near_hi <= n - 2 forward, near_lo >= 1 backward
+// (tests/cullide/quick_cullide_test.cpp compares every view's counts with the recorded passes',
+// which run the schedule).
+int pass_counts(const Item& it, std::uint8_t tag, bool forward, std::size_t n) {
     const std::uint8_t proven = forward ? kFFV : kSFV;
     const std::uint8_t other = forward ? kSFV : kFFV;
-    const std::size_t n = items.size();
-    std::uint64_t queries = 0, triangles = 0;
-    for (std::size_t k = 0; k < n; ++k) {
-        const Item& it = items[k];
-        const bool queried = !(tags[k] & proven);
-        const bool written = !(tags[k] & other) && (forward ? std::size_t{it.near_hi} + 2 <= n : it.near_lo >= 1);
-        queries += queried ? 1 : 0;
-        triangles += (queried ? it.count : 0) + (written ? it.count : 0);
-    }
-    vs.queries += queries;
-    vs.triangles_rasterized += triangles;
+    const bool queried = !(tag & proven);
+    const bool written = !(tag & other) && (forward ? std::size_t{it.near_hi} + 2 <= n : it.near_lo >= 1);
+    return (queried ? 1 : 0) + 4 * ((queried ? 1 : 0) + (written ? 1 : 0));
 }
 
 // Both passes of one exact-bounds view as the device's quick_view (query_device.h: natively on the
@@ -217,17 +210,25 @@ Result<std::uint64_t> native_view(const std::vector<Geom>& geoms, std::vector<It
     if (!r) return r.error();
     if (r.value().size() != items.size())
         return Error{"device returned " + std::to_string(r.value().size()) + " tags for " + std::to_string(items.size()) + " items"};
-    count_pass(items, tags, true, vs);
-    std::vector<std::uint8_t> after_forward(items.size());
-    for (std::size_t i = 0; i < items.size(); ++i)
-        after_forward[i] = static_cast<std::uint8_t>(tags[i] | (r.value()[i] & kFFV));
-    count_pass(items, after_forward, false, vs);
-    std::uint64_t changed = 0;
-    for (std::size_t i = 0; i < items.size(); ++i) {
-        const std::uint8_t now = r.value()[i];
-        changed += static_cast<std::uint64_t>(((now & kFFV) && !(tags[i] & kFFV)) + ((now & kSFV) && !(tags[i] & kSFV)));
-        items[i].tag = now;
+    // One pass over the items (each pass over 100,000 items is memory-bound serial work): the tags
+    // gained, the new tags, the items left live, and both passes' counts (pass_counts; the backward
+    // pass with the tags the forward pass left).
+    std::uint64_t changed = 0, queries = 0, triangles = 0, live = 0;
+    const std::size_t n = items.size();
+    for (std::size_t i = 0; i < n; ++i) {
+        Item& it = items[i];
+        const std::uint8_t before = tags[i], now = r.value()[i];
+        const auto after_forward = static_cast<std::uint8_t>(before | (now & kFFV));
+        const int counted = pass_counts(it, before, true, n) + pass_counts(it, after_forward, false, n);
+        queries += static_cast<std::uint64_t>(counted & 3);
+        triangles += static_cast<std::uint64_t>(counted >> 2) * it.count;
+        changed += static_cast<std::uint64_t>(((now & kFFV) && !(before & kFFV)) + ((now & kSFV) && !(before & kSFV)));
+        it.tag = now;
+        live += now != kBFV ? 1 : 0;
     }
+    vs.queries += queries;
+    vs.triangles_rasterized += triangles;
+    vs.items_after = live;
     return changed;
 }
 
@@ -266,7 +267,7 @@ Status run_stage(std::vector<Geom>& geoms, std::vector<Item>& items, CullStage s
         vs.items_before = live;
         std::uint64_t changed = 0;  // tags gained in this view
         if (o.mode == VisibilityMode::ExactBounds && o.fused_visibility) {
-            Result<std::uint64_t> gained = native_view(geoms, items, o, size, device, vs);
+            Result<std::uint64_t> gained = native_view(geoms, items, o, size, device, vs);  // sets items_after
             if (!gained) return gained.error();
             changed = gained.value();
         } else {
@@ -275,8 +276,8 @@ Status run_stage(std::vector<Geom>& geoms, std::vector<Item>& items, CullStage s
                 if (!gained) return gained.error();
                 changed += gained.value();
             }
+            vs.items_after = count_live(items);
         }
-        vs.items_after = count_live(items);
         st.queries += vs.queries;
         st.triangles_rasterized += vs.triangles_rasterized;
         st.views.push_back(vs);
