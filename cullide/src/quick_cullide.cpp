@@ -377,20 +377,31 @@ Geom make_mesh_geom(const Mesh& m, std::uint32_t object, std::vector<std::uint32
 // Splits every geometry with a live parent into items of `group` positions, inheriting the
 // parent's tag; parents are consecutive runs of `parents` per geometry. Non-self near range: the
 // object's items.
-std::vector<Item> split_items(const std::vector<Geom>& geoms, const std::vector<Item>& parents, std::size_t group) {
-    std::vector<Item> items;
-    for (const Item& p : parents) {
-        if (p.tag == kBFV) continue;
-        for (std::uint32_t f = p.first; f < p.first + p.count; f += static_cast<std::uint32_t>(group)) {
-            Item it;
-            it.geom = p.geom;
-            it.first = f;
-            it.count = std::min<std::uint32_t>(static_cast<std::uint32_t>(group), p.first + p.count - f);
-            for (std::uint32_t q = f; q < f + it.count; ++q) it.box = detail::unite(it.box, geoms[p.geom].tri_box[q]);
-            it.tag = p.tag;
-            items.push_back(it);
+// The parents' items are counted first and made in parallel parts of about kSplitPart parents, each
+// writing its own run of the list (perf: 4.6% of a 2-thread bunny-dragon frame's calling thread,
+// splitting 42,000 sub-objects into single triangles).
+std::vector<Item> split_items(const std::vector<Geom>& geoms, const std::vector<Item>& parents, std::size_t group,
+                              int threads) {
+    std::vector<std::size_t> at(parents.size() + 1, 0);
+    for (std::size_t i = 0; i < parents.size(); ++i)
+        at[i + 1] = at[i] + (parents[i].tag == kBFV ? 0 : (parents[i].count + group - 1) / group);
+    std::vector<Item> items(at.back());
+    constexpr std::size_t kSplitPart = 2048;
+    detail::parallel_chunks(threads, (parents.size() + kSplitPart - 1) / kSplitPart, [&](std::size_t part) {
+        for (std::size_t i = part * kSplitPart; i < std::min(parents.size(), (part + 1) * kSplitPart); ++i) {
+            const Item& p = parents[i];
+            if (p.tag == kBFV) continue;
+            std::size_t out = at[i];
+            for (std::uint32_t f = p.first; f < p.first + p.count; f += static_cast<std::uint32_t>(group)) {
+                Item& it = items[out++];
+                it.geom = p.geom;
+                it.first = f;
+                it.count = std::min<std::uint32_t>(static_cast<std::uint32_t>(group), p.first + p.count - f);
+                for (std::uint32_t q = f; q < f + it.count; ++q) it.box = detail::unite(it.box, geoms[p.geom].tri_box[q]);
+                it.tag = p.tag;
+            }
         }
-    }
+    });
     return items;
 }
 
@@ -534,13 +545,13 @@ Status separate_stages(std::span<const Mesh> objects, std::span<const std::uint3
 
     // Stage 3: sub-objects; stage 4: single triangles (when sub-objects hold more than one).
     t0 = Clock::now();
-    items = split_items(geoms, items, group);
+    items = split_items(geoms, items, group, options.threads);
     set_object_near(items);
     st.subobjects = items.size();
     if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, size, device, st); !s) return s;
     st.pcs_subobjects = count_live(items);
     if (group > 1) {
-        items = split_items(geoms, items, 1);
+        items = split_items(geoms, items, 1, options.threads);
         set_object_near(items);
         st.triangles_in = items.size();
         if (Status s = run_stage(geoms, items, CullStage::SubObjects, options, size, device, st); !s) return s;
@@ -578,7 +589,7 @@ Status self_stage(std::span<const Mesh> objects, std::span<const std::uint32_t> 
         whole.geom = gi;
         whole.count = static_cast<std::uint32_t>(m.triangles.size());
         const std::size_t s = items.size();
-        std::vector<Item> parts = split_items(geoms, std::vector<Item>{whole}, group);
+        std::vector<Item> parts = split_items(geoms, std::vector<Item>{whole}, group, 1);
         const std::size_t e = s + parts.size();
         for (std::size_t k = 0; k < parts.size(); ++k) {
             const std::size_t pos = s + k;
