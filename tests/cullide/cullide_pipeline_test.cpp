@@ -333,16 +333,21 @@ TEST_CASE("every method refuses coordinates outside the exact range, as the grou
     }
 }
 
+namespace {
+// Six overlapping cubes of 12 triangles, c0 .. c5: more than kSerialFrameTriangles (64) triangles, so
+// the scene checks run in parallel jobs.
+std::vector<cullide::Mesh> six_cubes() {
+    std::vector<cullide::Mesh> objects;
+    for (int o = 0; o < 6; ++o) objects.push_back(cube({0.4 * o, 0, 0}, 1.0, std::string("c").append(std::to_string(o))));
+    return objects;
+}
+}  // namespace
+
 TEST_CASE("every method names the first problem the serial scene checks name (exact and auto in exact_pairs' scan)") {
     // process_frame leaves the scene checks of a frame that goes straight to exact_pairs over every
     // object to exact_pairs' parallel scan: the message must be the one validate_scene, then
     // validate_exact_range, give, naming the first problem in that order.
-    const auto scene = [] {
-        std::vector<cullide::Mesh> objects;
-        // Six cubes of 12 triangles: more than kSerialFrameTriangles (64), so the checks run in parallel jobs.
-        for (int o = 0; o < 6; ++o) objects.push_back(cube({0.4 * o, 0, 0}, 1.0, std::string("c").append(std::to_string(o))));
-        return objects;
-    };
+    const auto scene = six_cubes;
     struct Case {
         const char* what;
         std::vector<cullide::Mesh> objects;
@@ -402,11 +407,7 @@ TEST_CASE("cullide_pairs and quick_cullide_pairs name the first problem the seri
     // Both check their own inputs (the public entry points), each object in its own parallel job
     // (session 12): validate_scene's first problem, then the active list's, then the exact range's,
     // in that order, whatever the thread count.
-    const auto scene = [] {
-        std::vector<cullide::Mesh> objects;
-        for (int o = 0; o < 6; ++o) objects.push_back(cube({0.4 * o, 0, 0}, 1.0, std::string("c").append(std::to_string(o))));
-        return objects;
-    };
+    const auto scene = six_cubes;
     struct Case {
         const char* what;
         std::vector<cullide::Mesh> objects;
