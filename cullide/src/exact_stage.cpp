@@ -193,8 +193,9 @@ void bin_task(Task& task, const std::vector<SweepRef>& refs, std::size_t first_c
         std::uint32_t u0, u1, v0, v1;
     };
     std::vector<Span> spans(refs.size());
-    const std::size_t chunks =
-        std::min<std::size_t>((refs.size() + kBinChunk - 1) / kBinChunk, 4 * static_cast<std::size_t>(effective_threads(threads)));
+    // (At most 32 chunks: each holds a count per slot.)
+    const std::size_t chunks = std::min<std::size_t>(
+        (refs.size() + kBinChunk - 1) / kBinChunk, std::min<std::size_t>(32, 4 * static_cast<std::size_t>(effective_threads(threads))));
     const std::size_t per_chunk = chunks > 0 ? (refs.size() + chunks - 1) / chunks : 0;
     // at[chunk * slots + k]: chunk's count in slot k, then (after the scan) where it writes there.
     std::vector<std::uint32_t> at(chunks * slots, 0);
@@ -345,9 +346,8 @@ class TaskBuilder {
     }
 
     // The tasks added, in the order added; made on up to `threads` workers (binning a task is the
-    // stage's largest serial cost otherwise).
-    // With fewer tasks than workers (a bunny inside a dragon: one), each task is made in turn with
-    // every worker (make_task's chunks); otherwise one task per job.
+    // stage's largest serial cost otherwise): one task per job or, with fewer tasks than workers (a
+    // bunny inside a dragon: one), each task in turn with every worker (make_task's chunks).
     std::vector<Task> take_tasks(int threads) {
         std::vector<Task> tasks(pending_.size());
         const auto make = [&](std::size_t t, int inner) {
