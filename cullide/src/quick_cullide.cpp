@@ -176,18 +176,21 @@ Result<std::uint64_t> run_pass(const std::vector<Geom>& geoms, std::vector<Item>
 }
 
 // What one recorded pass (run_pass) would submit of item `it` (of n) with tag `tag`, the native
-// view reporting what it replaces: (1 if queried) + 4 * (its draws: the query's and the write's),
+// view reporting what it replaces: its query (0 or 1) and its draws (the query's and the write's),
 // in closed form: detail::quick_pass_schedule queries every item once and, the windows being
 // non-decreasing (the device checked them), writes exactly the items whose window ends before the
 // pass's last query: near_hi <= n - 2 forward, near_lo >= 1 backward
 // (tests/cullide/quick_cullide_test.cpp compares every view's counts with the recorded passes',
 // which run the schedule).
-int pass_counts(const Item& it, std::uint8_t tag, bool forward, std::size_t n) {
+struct PassCounts {
+    std::uint64_t queries = 0, draws = 0;
+};
+PassCounts pass_counts(const Item& it, std::uint8_t tag, bool forward, std::size_t n) {
     const std::uint8_t proven = forward ? kFFV : kSFV;
     const std::uint8_t other = forward ? kSFV : kFFV;
     const bool queried = !(tag & proven);
     const bool written = !(tag & other) && (forward ? std::size_t{it.near_hi} + 2 <= n : it.near_lo >= 1);
-    return (queried ? 1 : 0) + 4 * ((queried ? 1 : 0) + (written ? 1 : 0));
+    return {queried ? 1u : 0u, (queried ? 1u : 0u) + (written ? 1u : 0u)};
 }
 
 // Both passes of one exact-bounds view as the device's quick_view (query_device.h: natively on the
@@ -203,7 +206,7 @@ Result<std::uint64_t> native_view(const std::vector<Geom>& geoms, std::vector<It
         // `used` as the device sets it (query_device.h): not an item proven apart both ways.
         wi[i] = {raster::MeshViewD{g.clip_d, std::span<const std::uint32_t>(g.indices)
                                                  .subspan(std::size_t{it.first} * 3, std::size_t{it.count} * 3)},
-                 it.near_lo, it.near_hi, (it.tag & (kFFV | kSFV)) != (kFFV | kSFV)};
+                 it.near_lo, it.near_hi, it.tag != kBFV};
         tags[i] = it.tag;
     }
     Result<std::vector<std::uint8_t>> r = device.quick_view(size, o.depth_format, wi, tags);
@@ -219,9 +222,9 @@ Result<std::uint64_t> native_view(const std::vector<Geom>& geoms, std::vector<It
         Item& it = items[i];
         const std::uint8_t before = tags[i], now = r.value()[i];
         const auto after_forward = static_cast<std::uint8_t>(before | (now & kFFV));
-        const int counted = pass_counts(it, before, true, n) + pass_counts(it, after_forward, false, n);
-        queries += static_cast<std::uint64_t>(counted & 3);
-        triangles += static_cast<std::uint64_t>(counted >> 2) * it.count;
+        const PassCounts f = pass_counts(it, before, true, n), b = pass_counts(it, after_forward, false, n);
+        queries += f.queries + b.queries;
+        triangles += (f.draws + b.draws) * it.count;
         changed += static_cast<std::uint64_t>(((now & kFFV) && !(before & kFFV)) + ((now & kSFV) && !(before & kSFV)));
         it.tag = now;
         live += now != kBFV ? 1 : 0;
