@@ -117,17 +117,35 @@ namespace {
 using detail::make_view;
 using detail::unite;
 
-// This view's offset solids of one object (see ObjectGeometry).
-Status prepare_offset_geometry(ObjectGeometry& og, CullStage stage, const raster::OrthoView& view) {
-    raster::Result<raster::OffsetMesh> m =
-        stage == CullStage::Objects ? raster::object_offset_obbs(view, og.positions, og.indices)
-        : stage == CullStage::Boxes
-            // The box of the degenerate triangle (lo, hi, lo) is the object's box.
-            ? raster::triangle_offset_boxes(view, og.positions, std::array<std::uint32_t, 3>{0, 7, 0})
-            : raster::triangle_offset_boxes(view, og.positions, og.indices);
-    if (!m) return Error{"offset geometry: " + m.error().message};
-    og.offset = std::move(m).value();
-    return Status{};
+// Offset solids' boxes per parallel job of a view's preparation (prepare_view): one job per object
+// left the second thread idle where one object holds most of the triangles (the tree of leaves: 7 ms
+// per sub-object view on one thread, whatever the PCS).
+constexpr std::size_t kOffsetPartTriangles = 4096;
+constexpr std::uint32_t kObbTriangles = 16;  // raster::object_offset_obbs' default group
+
+// How many offset solids (boxes) object `og` has at `stage`.
+std::size_t offset_boxes(const ObjectGeometry& og, CullStage stage) {
+    const std::size_t tris = og.indices.size() / 3;
+    if (stage == CullStage::Boxes) return 1;
+    if (stage == CullStage::Objects) return (tris + kObbTriangles - 1) / kObbTriangles;
+    return tris;
+}
+std::size_t offset_part_boxes(CullStage stage) {
+    return stage == CullStage::Objects ? kOffsetPartTriangles / kObbTriangles : kOffsetPartTriangles;
+}
+
+// This view's offset solids [first, last) of one object (see ObjectGeometry), written into its
+// offset mesh (sized for every box by the caller); returns their overshoot of the depth range.
+raster::Result<double> prepare_offset_part(ObjectGeometry& og, CullStage stage, const raster::OrthoView& view,
+                                           std::size_t first, std::size_t last) {
+    // The box of the degenerate triangle (lo, hi, lo) is the object's box.
+    static constexpr std::array<std::uint32_t, 3> kBoxCorners{0, 7, 0};
+    return stage == CullStage::Objects ? raster::object_offset_obbs_part(view, og.positions, og.indices, first, last,
+                                                                         og.offset, kObbTriangles)
+           : stage == CullStage::Boxes ? raster::triangle_offset_boxes_part(view, og.positions, kBoxCorners, first,
+                                                                            last, og.offset)
+                                       : raster::triangle_offset_boxes_part(view, og.positions, og.indices, first, last,
+                                                                            og.offset);
 }
 
 std::uint64_t count_live(const std::vector<ObjectGeometry>& g) {
@@ -321,18 +339,67 @@ Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_
             }
             return Status{};
         }
-        // Offset solids: one object per parallel job (each writes only its own geometry); the
-        // first failure in order is reported.
-        std::vector<Status> prepared(order.size());
-        detail::parallel_chunks(o.threads, order.size(), [&](std::size_t k) {
-            prepared[k] = prepare_offset_geometry(g[order[k]], stage, view.value());
+        // Offset solids: parts of about kOffsetPartTriangles triangles per parallel job, each
+        // writing only its own boxes of its object's offset mesh (sized here; the memory is kept
+        // between views). The sub-object stage writes the boxes of live items only (no draw reads
+        // the others), but fits the view to every box of the live objects as before: the other
+        // boxes give their overshoot without being written. The first failure in order is
+        // reported (the objects were validated before the first view, so what can fail is a box's
+        // own arithmetic, named by its triangle), and the overshoot is the largest of the parts'.
+        struct Part {
+            std::size_t k, first, last;  // boxes [first, last) of order[k]; sub-objects: items
+        };
+        std::vector<Part> parts;
+        const std::size_t per_part = offset_part_boxes(stage);
+        for (std::size_t k = 0; k < order.size(); ++k) {
+            ObjectGeometry& og = g[order[k]];
+            const std::size_t n = offset_boxes(og, stage);
+            raster::size_offset_boxes(n, og.offset);
+            if (stage != CullStage::SubObjects) {
+                for (std::size_t b = 0; b < n; b += per_part) parts.push_back({k, b, std::min(n, b + per_part)});
+                continue;
+            }
+            for (std::size_t i = 0, tris = 0, first = 0; i < og.items.size(); ++i) {
+                tris += og.items[i].index_count / 3;
+                if (tris >= per_part || i + 1 == og.items.size()) {
+                    parts.push_back({k, first, i + 1});
+                    first = i + 1;
+                    tris = 0;
+                }
+            }
+        }
+        std::vector<raster::Result<double>> prepared(parts.size(), 0.0);
+        detail::parallel_chunks(o.threads, parts.size(), [&](std::size_t j) {
+            ObjectGeometry& og = g[order[parts[j].k]];
+            if (stage != CullStage::SubObjects) {
+                prepared[j] = prepare_offset_part(og, stage, view.value(), parts[j].first, parts[j].last);
+                return;
+            }
+            // Runs of items alike in liveness (the items cover the triangles in order).
+            double over = 0.0;
+            for (std::size_t i = parts[j].first; i < parts[j].last;) {
+                const bool live = og.items[i].live;
+                std::size_t e = i + 1;
+                while (e < parts[j].last && og.items[e].live == live) ++e;
+                const std::size_t b0 = og.items[i].first_index / 3;
+                const std::size_t b1 = (og.items[e - 1].first_index + og.items[e - 1].index_count) / 3;
+                raster::Result<double> r =
+                    live ? prepare_offset_part(og, stage, view.value(), b0, b1)
+                         : raster::triangle_offset_boxes_overshoot(view.value(), og.positions, og.indices, b0, b1);
+                if (!r) {
+                    prepared[j] = std::move(r);
+                    return;
+                }
+                over = std::max(over, r.value());
+                i = e;
+            }
+            prepared[j] = over;
         });
-        for (const Status& s : prepared)
-            if (!s) return s;
         double overshoot = 0.0;  // in clip units beyond [-1, 1]
-        for (std::size_t i : order)
-            for (const raster::Float4& v : g[i].offset.vertices)
-                overshoot = std::max({overshoot, static_cast<double>(v.z) - 1.0, -1.0 - static_cast<double>(v.z)});
+        for (const raster::Result<double>& p : prepared) {
+            if (!p) return Error{"offset geometry: " + p.error().message};
+            overshoot = std::max(overshoot, p.value());
+        }
         if (overshoot == 0.0) return Status{};
         if (attempt == 8) return Error{"offset solids do not fit the view's depth range after 8 attempts"};
         const double world_per_clip =

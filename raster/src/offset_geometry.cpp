@@ -70,12 +70,10 @@ Frame frame_of(const OrthoView& view) {
     return f;
 }
 
-Status validate_mesh(std::span<const Double3> vertices, std::span<const std::uint32_t> indices,
-                     const char* what) {
-    if (indices.size() % 3 != 0)
-        return Error{std::string(what) + ": index count " + std::to_string(indices.size()) +
-                     " is not a multiple of 3"};
-    for (std::size_t k = 0; k < indices.size(); ++k) {
+// The checks of indices [first, last) of the list (positions named as in the whole list).
+Status validate_range(std::span<const Double3> vertices, std::span<const std::uint32_t> indices, std::size_t first,
+                      std::size_t last, const char* what) {
+    for (std::size_t k = first; k < last; ++k) {
         if (indices[k] >= vertices.size())
             return Error{std::string(what) + ": triangle " + std::to_string(k / 3) + ": index " +
                          std::to_string(indices[k]) + " at position " + std::to_string(k) +
@@ -88,14 +86,43 @@ Status validate_mesh(std::span<const Double3> vertices, std::span<const std::uin
     return {};
 }
 
-// (One range insert per list: a push_back per element, with its capacity test, was 7.8% of a
-// leaves / rcullide-offset frame's instructions, callgrind.)
-void append_box(OffsetMesh& out, const std::array<Float4, 8>& corners) {
-    const auto base = static_cast<std::uint32_t>(out.vertices.size());
-    std::array<std::uint32_t, 36> idx;
+Status check_count(std::span<const std::uint32_t> indices, const char* what) {
+    if (indices.size() % 3 != 0)
+        return Error{std::string(what) + ": index count " + std::to_string(indices.size()) +
+                     " is not a multiple of 3"};
+    return {};
+}
+
+Status validate_mesh(std::span<const Double3> vertices, std::span<const std::uint32_t> indices,
+                     const char* what) {
+    if (Status s = check_count(indices, what); !s) return s;
+    return validate_range(vertices, indices, 0, indices.size(), what);
+}
+
+// A part call's checks of `out` and its box range.
+Status check_part(const OffsetMesh& out, std::size_t total_boxes, std::size_t first_box, std::size_t last_box,
+                  const char* what) {
+    if (out.vertices.size() != 8 * total_boxes || out.indices.size() != 36 * total_boxes)
+        return Error{std::string(what) + ": the output holds " + std::to_string(out.vertices.size()) + " vertices and " +
+                     std::to_string(out.indices.size()) + " indices, not those of " + std::to_string(total_boxes) +
+                     " boxes (size_offset_boxes)"};
+    if (first_box > last_box || last_box > total_boxes)
+        return Error{std::string(what) + ": boxes [" + std::to_string(first_box) + ", " + std::to_string(last_box) +
+                     ") are not a range of the " + std::to_string(total_boxes) + " boxes"};
+    return {};
+}
+
+// Box b's corners and indices into their places in `out` (sized for every box); returns the
+// corners' overshoot of the clip depth range.
+double store_box(OffsetMesh& out, std::size_t b, const std::array<Float4, 8>& corners) {
+    std::copy(corners.begin(), corners.end(), out.vertices.begin() + static_cast<std::ptrdiff_t>(8 * b));
+    const auto base = static_cast<std::uint32_t>(8 * b);
+    std::uint32_t* idx = out.indices.data() + 36 * b;
     for (std::size_t k = 0; k < 36; ++k) idx[k] = base + kBox[k];
-    out.vertices.insert(out.vertices.end(), corners.begin(), corners.end());
-    out.indices.insert(out.indices.end(), idx.begin(), idx.end());
+    double overshoot = 0.0;
+    for (const Float4& v : corners)
+        overshoot = std::max({overshoot, static_cast<double>(v.z) - 1.0, -1.0 - static_cast<double>(v.z)});
+    return overshoot;
 }
 
 // view_axes (transform.h) with the view's axis order decoded once (view_axis_indices): the
@@ -130,16 +157,19 @@ double offset_radius(const OrthoView& view) {
     return std::nextafter(r, HUGE_VAL);
 }
 
-Result<OffsetMesh> triangle_offset_boxes(const OrthoView& view, std::span<const Double3> vertices,
-                                         std::span<const std::uint32_t> indices) {
-    if (Status s = validate_mesh(vertices, indices, "triangle_offset_boxes"); !s) return s.error();
+namespace {
+
+// Boxes [first, last) of (a) (= triangles), on validated input: their overshoot, and with Store
+// the boxes into `out`.
+template <bool Store>
+Result<double> write_triangle_boxes(const OrthoView& view, std::span<const Double3> vertices,
+                                    std::span<const std::uint32_t> indices, std::size_t first, std::size_t last,
+                                    OffsetMesh* out) {
     const Frame f = frame_of(view);
     const double r = offset_radius(view);
     const AxisMap to_view(view);
-    OffsetMesh out;
-    out.vertices.reserve(indices.size() / 3 * 8);
-    out.indices.reserve(indices.size() / 3 * 36);
-    for (std::size_t t = 0; t + 2 < indices.size(); t += 3) {
+    double overshoot = 0.0;
+    for (std::size_t t = 3 * first; t < 3 * last; t += 3) {
         Double3 lo{HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
         for (int k = 0; k < 3; ++k) {
             const Double3 a = to_view(vertices[indices[t + static_cast<std::size_t>(k)]]);
@@ -153,6 +183,28 @@ Result<OffsetMesh> triangle_offset_boxes(const OrthoView& view, std::span<const 
         // before the "- 1"), the total is below 6u M + u |c|; the margin (M + |c| + 1) 2^-49 = 16u
         // (M + |c| + 1) covers it with room for its own rounding. (A margin relative to |c| alone
         // is too small when the view box lies far from the origin: the aarch64 run found one.)
+        if constexpr (!Store) {
+            // Only the overshoot is wanted, and a box adds to it only when it lies wholly beyond
+            // a depth plane: cmin <= l and cmax >= h (with margins >= 0, the roundings go down and
+            // up, saturation clamps beyond +-2^64), so with l <= 1 and h >= -1 in depth, clamp_box
+            // leaves both depths in [-1, 1] and the box adds nothing. These are the same l and h
+            // as below, and nothing below fails unless a rounding's argument is NaN (saturation
+            // keeps the rest finite), so skipping the rest of such a box changes neither the
+            // result nor the error.
+            bool nan = false, inside = false;
+            for (int k = 0; k < 3; ++k) {
+                const double scale = comp(f.scale, k);
+                const double l = (comp(lo, k) - r - comp(f.lo, k)) * scale - 1.0;
+                const double h = (comp(hi, k) + r - comp(f.lo, k)) * scale - 1.0;
+                const double big_l = (std::fabs(comp(lo, k)) + r + std::fabs(comp(f.lo, k))) * scale;
+                const double big_h = (std::fabs(comp(hi, k)) + r + std::fabs(comp(f.lo, k))) * scale;
+                const double ml = (big_l + std::fabs(l) + 1.0) * 0x1p-49;
+                const double mh = (big_h + std::fabs(h) + 1.0) * 0x1p-49;
+                nan = nan || std::isnan(l - ml) || std::isnan(h + mh);
+                inside = ml >= 0.0 && mh >= 0.0 && l <= 1.0 && h >= -1.0;  // kept for k = 2, the depth
+            }
+            if (!nan && inside) continue;
+        }
         float cmin[3], cmax[3];
         for (int k = 0; k < 3; ++k) {
             const double scale = comp(f.scale, k);
@@ -167,26 +219,71 @@ Result<OffsetMesh> triangle_offset_boxes(const OrthoView& view, std::span<const 
                              ": its box overflows float in clip space"};
         }
         clamp_box(cmin, cmax);
+        if constexpr (!Store) {  // store_box's overshoot: the corners' depths are cmin[2] and cmax[2]
+            overshoot = std::max({overshoot, static_cast<double>(cmax[2]) - 1.0, -1.0 - static_cast<double>(cmin[2]),
+                                  static_cast<double>(cmin[2]) - 1.0, -1.0 - static_cast<double>(cmax[2])});
+            continue;
+        }
         std::array<Float4, 8> corners{};
         for (int c = 0; c < 8; ++c)
             corners[static_cast<std::size_t>(c)] = {(c & 1) ? cmax[0] : cmin[0], (c & 2) ? cmax[1] : cmin[1],
                                                     (c & 4) ? cmax[2] : cmin[2], 1.0f};
-        append_box(out, corners);
+        overshoot = std::max(overshoot, store_box(*out, t / 3, corners));
     }
+    return overshoot;
+}
+
+}  // namespace
+
+Result<OffsetMesh> triangle_offset_boxes(const OrthoView& view, std::span<const Double3> vertices,
+                                         std::span<const std::uint32_t> indices) {
+    if (Status s = validate_mesh(vertices, indices, "triangle_offset_boxes"); !s) return s.error();
+    OffsetMesh out;
+    size_offset_boxes(indices.size() / 3, out);
+    if (Result<double> w = write_triangle_boxes<true>(view, vertices, indices, 0, indices.size() / 3, &out); !w)
+        return w.error();
     return out;
 }
 
-Result<OffsetMesh> object_offset_obbs(const OrthoView& view, std::span<const Double3> vertices,
-                                      std::span<const std::uint32_t> indices,
-                                      std::uint32_t triangles_per_box) {
-    if (Status s = validate_mesh(vertices, indices, "object_offset_obbs"); !s) return s.error();
-    if (triangles_per_box < 1) return Error{"object_offset_obbs: triangles_per_box must be >= 1"};
+Result<double> triangle_offset_boxes_part(const OrthoView& view, std::span<const Double3> vertices,
+                                          std::span<const std::uint32_t> indices, std::size_t first_box,
+                                          std::size_t last_box, OffsetMesh& out) {
+    constexpr const char* kWhat = "triangle_offset_boxes";
+    if (Status s = check_count(indices, kWhat); !s) return s.error();
+    if (Status s = check_part(out, indices.size() / 3, first_box, last_box, kWhat); !s) return s.error();
+    if (Status s = validate_range(vertices, indices, 3 * first_box, 3 * last_box, kWhat); !s) return s.error();
+    return write_triangle_boxes<true>(view, vertices, indices, first_box, last_box, &out);
+}
+
+Result<double> triangle_offset_boxes_overshoot(const OrthoView& view, std::span<const Double3> vertices,
+                                               std::span<const std::uint32_t> indices, std::size_t first_box,
+                                               std::size_t last_box) {
+    constexpr const char* kWhat = "triangle_offset_boxes";
+    if (Status s = check_count(indices, kWhat); !s) return s.error();
+    if (first_box > last_box || last_box > indices.size() / 3)
+        return Error{std::string(kWhat) + ": boxes [" + std::to_string(first_box) + ", " + std::to_string(last_box) +
+                     ") are not a range of the " + std::to_string(indices.size() / 3) + " boxes"};
+    if (Status s = validate_range(vertices, indices, 3 * first_box, 3 * last_box, kWhat); !s) return s.error();
+    return write_triangle_boxes<false>(view, vertices, indices, first_box, last_box, nullptr);
+}
+
+namespace {
+
+std::size_t obb_count(std::size_t triangles, std::uint32_t triangles_per_box) {
+    return (triangles + triangles_per_box - 1) / triangles_per_box;
+}
+
+// Boxes [first, last) of (b) into `out`, on validated input; their overshoot.
+Result<double> write_obbs(const OrthoView& view, std::span<const Double3> vertices,
+                          std::span<const std::uint32_t> indices, std::size_t first, std::size_t last,
+                          OffsetMesh& out, std::uint32_t triangles_per_box) {
     const Frame f = frame_of(view);
     const double r = offset_radius(view);
     const AxisMap to_view(view);
     const std::size_t tris = indices.size() / 3;
-    OffsetMesh out;
-    for (std::size_t g0 = 0; g0 < tris; g0 += triangles_per_box) {
+    double overshoot = 0.0;
+    for (std::size_t g0 = first * triangles_per_box; g0 < std::min(tris, last * triangles_per_box);
+         g0 += triangles_per_box) {
         const std::size_t g1 = std::min(tris, g0 + triangles_per_box);
         // Frame candidates, in view coordinates (u, v, d), each right-handed and Gram-Schmidt
         // orthonormalized (a0, a1, a2 = a0 x a1): the view axes, and for the group's largest
@@ -309,9 +406,45 @@ Result<OffsetMesh> object_offset_obbs(const OrthoView& view, std::span<const Dou
                 return Error{"object_offset_obbs: box of triangles " + std::to_string(g0) + ".." +
                              std::to_string(g1 - 1) + " overflows float in clip space"};
         }
-        append_box(out, corners);
+        overshoot = std::max(overshoot, store_box(out, g0 / triangles_per_box, corners));
     }
+    return overshoot;
+}
+
+}  // namespace
+
+Result<OffsetMesh> object_offset_obbs(const OrthoView& view, std::span<const Double3> vertices,
+                                      std::span<const std::uint32_t> indices,
+                                      std::uint32_t triangles_per_box) {
+    if (Status s = validate_mesh(vertices, indices, "object_offset_obbs"); !s) return s.error();
+    if (triangles_per_box < 1) return Error{"object_offset_obbs: triangles_per_box must be >= 1"};
+    OffsetMesh out;
+    const std::size_t boxes = obb_count(indices.size() / 3, triangles_per_box);
+    size_offset_boxes(boxes, out);
+    if (Result<double> w = write_obbs(view, vertices, indices, 0, boxes, out, triangles_per_box); !w)
+        return w.error();
     return out;
+}
+
+Result<double> object_offset_obbs_part(const OrthoView& view, std::span<const Double3> vertices,
+                                       std::span<const std::uint32_t> indices, std::size_t first_box,
+                                       std::size_t last_box, OffsetMesh& out, std::uint32_t triangles_per_box) {
+    constexpr const char* kWhat = "object_offset_obbs";
+    if (Status s = check_count(indices, kWhat); !s) return s.error();
+    if (triangles_per_box < 1) return Error{"object_offset_obbs: triangles_per_box must be >= 1"};
+    const std::size_t tris = indices.size() / 3;
+    if (Status s = check_part(out, obb_count(tris, triangles_per_box), first_box, last_box, kWhat); !s)
+        return s.error();
+    if (Status s = validate_range(vertices, indices, 3 * std::min(tris, first_box * triangles_per_box),
+                                  3 * std::min(tris, last_box * triangles_per_box), kWhat);
+        !s)
+        return s.error();
+    return write_obbs(view, vertices, indices, first_box, last_box, out, triangles_per_box);
+}
+
+void size_offset_boxes(std::size_t boxes, OffsetMesh& out) {
+    out.vertices.resize(8 * boxes);
+    out.indices.resize(36 * boxes);
 }
 
 }  // namespace raster

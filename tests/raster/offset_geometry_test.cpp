@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <span>
 #include <string>
@@ -306,6 +307,130 @@ TEST_CASE("Offset boxes: CullFace::Back draws the near faces and CullFace::Front
             }
         }
     }
+}
+
+// The largest overshoot of the clip depth range over boxes [first, last) of a whole call's output,
+// read from its corners: the reference for the part calls' results.
+double scan_overshoot(const raster::OffsetMesh& m, std::size_t first, std::size_t last) {
+    double o = 0.0;
+    for (std::size_t k = 8 * first; k < 8 * last; ++k) {
+        const double z = m.vertices[k].z;
+        o = std::max({o, z - 1.0, -1.0 - z});
+    }
+    return o;
+}
+
+bool same_bits(const raster::Float4& a, const raster::Float4& b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+TEST_CASE("Offset boxes in parts are the whole call's, bit for bit; the overshoot alone is a part's") {
+    test::Rng rng(31);
+    int beyond = 0, fitting = 0;  // ranges whose overshoot is positive / zero (both must be met)
+    for (int rep = 0; rep < 200; ++rep) {
+        CAPTURE(rep);
+        const auto f = static_cast<raster::DepthFormat>(rep % 3);
+        const raster::OrthoView v = random_view(rng, static_cast<raster::Axis>((rep / 3) % 3), f);
+        // Points in a box three times the view's, so that some boxes lie wholly beyond a depth plane
+        // (those are the ones that overshoot), some cross one and some fit.
+        std::vector<Double3> pts;
+        const int n = 3 + static_cast<int>(rng.below(60));
+        const Double3 ext{v.box_max.x - v.box_min.x, v.box_max.y - v.box_min.y, v.box_max.z - v.box_min.z};
+        for (int i = 0; i < n; ++i) {
+            const double x = rng.uniform(v.box_min.x - ext.x, v.box_max.x + ext.x);
+            const double y = rng.uniform(v.box_min.y - ext.y, v.box_max.y + ext.y);
+            const double z = rng.uniform(v.box_min.z - ext.z, v.box_max.z + ext.z);
+            pts.push_back({x, y, z});
+        }
+        // Triangles of nearby points (small boxes), a few spanning ones, and degenerate ones.
+        std::vector<std::uint32_t> idx;
+        const std::size_t tris = 1 + rng.below(40);
+        for (std::size_t t = 0; t < tris; ++t) {
+            const auto a = static_cast<std::uint32_t>(rng.below(static_cast<std::uint64_t>(n)));
+            for (int k = 0; k < 3; ++k)
+                idx.push_back(rng.below(4) == 0 ? static_cast<std::uint32_t>(rng.below(static_cast<std::uint64_t>(n)))
+                                                : a);
+        }
+        const auto whole_boxes = raster::triangle_offset_boxes(v, pts, idx);
+        REQUIRE(whole_boxes.ok());
+        const auto tpb = static_cast<std::uint32_t>(1 + rng.below(5));
+        const auto whole_obbs = raster::object_offset_obbs(v, pts, idx, tpb);
+        REQUIRE(whole_obbs.ok());
+        for (int kind = 0; kind < 2; ++kind) {
+            CAPTURE(kind);
+            const raster::OffsetMesh& whole = kind == 0 ? whole_boxes.value() : whole_obbs.value();
+            const std::size_t boxes = whole.vertices.size() / 8;
+            // Cut points, the parts run in reverse order into a mesh holding stale values first.
+            std::vector<std::size_t> cuts = {0, boxes};
+            for (int c = 0; c < 3; ++c) cuts.push_back(rng.below(boxes + 1));
+            std::sort(cuts.begin(), cuts.end());
+            raster::OffsetMesh parts;
+            parts.vertices.assign(8 * boxes + 5, raster::Float4{7, 7, 7, 7});
+            raster::size_offset_boxes(boxes, parts);
+            REQUIRE(parts.vertices.size() == 8 * boxes);
+            REQUIRE(parts.indices.size() == 36 * boxes);
+            for (std::size_t c = cuts.size() - 1; c-- > 0;) {
+                const std::size_t b0 = cuts[c], b1 = cuts[c + 1];
+                const raster::Result<double> o =
+                    kind == 0 ? raster::triangle_offset_boxes_part(v, pts, idx, b0, b1, parts)
+                              : raster::object_offset_obbs_part(v, pts, idx, b0, b1, parts, tpb);
+                REQUIRE(o.ok());
+                CHECK(o.value() == scan_overshoot(whole, b0, b1));
+                if (kind == 1) continue;
+                const raster::Result<double> alone = raster::triangle_offset_boxes_overshoot(v, pts, idx, b0, b1);
+                REQUIRE(alone.ok());
+                CHECK(alone.value() == o.value());
+                if (b1 > b0) (o.value() > 0.0 ? beyond : fitting) += 1;
+            }
+            // Box b's indices are the first box's shifted to its own corners [8 b, 8 b + 8).
+            bool shifted = true;
+            for (std::size_t k = 0; k < whole.indices.size(); ++k)
+                shifted = shifted && whole.indices[k] == whole.indices[k % 36] + 8 * (k / 36) && whole.indices[k % 36] < 8;
+            CHECK(shifted);
+            bool same = parts.indices == whole.indices;
+            for (std::size_t k = 0; k < whole.vertices.size(); ++k)
+                same = same && same_bits(parts.vertices[k], whole.vertices[k]);
+            CHECK(same);
+        }
+    }
+    CHECK(beyond > 20);
+    CHECK(fitting > 20);
+}
+
+TEST_CASE("Offset boxes in parts check their output and range, and validate their own triangles only") {
+    auto v = raster::make_ortho_view(raster::Axis::Z, {0, 0, 0}, {1, 1, 1}, 8, 8, raster::DepthFormat::D24);
+    REQUIRE(v.ok());
+    const std::vector<Double3> pts = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, std::nan(""), 0}};
+    const std::vector<std::uint32_t> idx = {0, 1, 2, 0, 1, 3, 0, 1, 9};
+    raster::OffsetMesh out;
+    auto r = raster::triangle_offset_boxes_part(v.value(), pts, idx, 0, 1, out);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().message.find("not those of 3 boxes (size_offset_boxes)") != std::string::npos);
+    raster::size_offset_boxes(3, out);
+    r = raster::triangle_offset_boxes_part(v.value(), pts, idx, 2, 4, out);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().message.find("boxes [2, 4) are not a range of the 3 boxes") != std::string::npos);
+    r = raster::triangle_offset_boxes_overshoot(v.value(), pts, idx, 1, 0);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().message.find("boxes [1, 0) are not a range") != std::string::npos);
+    // Triangle 0 is fine, 1 has a NaN vertex, 2 an index beyond the list: each part names its own.
+    r = raster::triangle_offset_boxes_part(v.value(), pts, idx, 0, 1, out);
+    CHECK(r.ok());
+    r = raster::triangle_offset_boxes_part(v.value(), pts, idx, 1, 3, out);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().message.find("triangle 1: vertex 3 is not finite") != std::string::npos);
+    r = raster::triangle_offset_boxes_overshoot(v.value(), pts, idx, 2, 3);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().message.find("triangle 2: index 9 at position 8") != std::string::npos);
+    r = raster::object_offset_obbs_part(v.value(), pts, idx, 0, 1, out, 1);
+    CHECK(r.ok());
+    r = raster::object_offset_obbs_part(v.value(), pts, idx, 0, 1, out, 2);  // 2 boxes of 2, not 3
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().message.find("not those of 2 boxes") != std::string::npos);
+    r = raster::object_offset_obbs_part(v.value(), pts, idx, 0, 1, out, 0);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().message.find("triangles_per_box must be >= 1") != std::string::npos);
+    r = raster::triangle_offset_boxes_overshoot(v.value(), pts, std::vector<std::uint32_t>{0, 1}, 0, 0);
+    REQUIRE_FALSE(r.ok());
+    CHECK(r.error().message.find("multiple of 3") != std::string::npos);
 }
 
 TEST_CASE("Offset geometry and view helpers reject bad input naming what is wrong") {

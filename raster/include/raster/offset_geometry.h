@@ -55,4 +55,31 @@ struct OffsetMesh {
                                                     std::span<const std::uint32_t> indices,
                                                     std::uint32_t triangles_per_box = 16);
 
+// Parts of (a) and (b), written in place, for callers that prepare one large object per view on
+// several threads and keep the memory between views. `out` must already hold every box of the whole
+// list (size_offset_boxes(boxes, out); (a) has one box per triangle, (b) ceil(triangles /
+// triangles_per_box)); the call writes boxes [first_box, last_box) only (vertices [8 first_box,
+// 8 last_box), indices [36 first_box, 36 last_box)), the same values as the whole call writes there,
+// so parts over disjoint ranges may run at once. It validates the triangles of its part only (a whole
+// call validates the whole list before any box: a caller that runs parts on unvalidated input and
+// wants the whole call's first error validates first) and fails, naming the triangle or box, on the
+// same problems as the whole call, or when `out` is not sized for `total_boxes` or the range lies
+// beyond it. Returns the part's largest overshoot of the clip depth range, max(0, z - 1, -1 - z) over
+// its box corners (the solids of a view that fits have none).
+[[nodiscard]] Result<double> triangle_offset_boxes_part(const OrthoView& view, std::span<const Double3> vertices,
+                                                        std::span<const std::uint32_t> indices, std::size_t first_box,
+                                                        std::size_t last_box, OffsetMesh& out);
+[[nodiscard]] Result<double> object_offset_obbs_part(const OrthoView& view, std::span<const Double3> vertices,
+                                                     std::span<const std::uint32_t> indices, std::size_t first_box,
+                                                     std::size_t last_box, OffsetMesh& out,
+                                                     std::uint32_t triangles_per_box = 16);
+// What triangle_offset_boxes_part would return for the same boxes (their overshoot, or the same
+// failure), without writing them: for a caller that draws only some of a view's boxes but fits the
+// view to all of them.
+[[nodiscard]] Result<double> triangle_offset_boxes_overshoot(const OrthoView& view, std::span<const Double3> vertices,
+                                                             std::span<const std::uint32_t> indices,
+                                                             std::size_t first_box, std::size_t last_box);
+// Sizes `out` for `boxes` boxes (8 vertices and 36 indices each), keeping its capacity.
+void size_offset_boxes(std::size_t boxes, OffsetMesh& out);
+
 }  // namespace raster
