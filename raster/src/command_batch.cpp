@@ -2,8 +2,10 @@
 #include "raster/command_batch.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <span>
 #include <string>
 
@@ -78,11 +80,22 @@ std::string cmd_name(std::size_t i) { return "command " + std::to_string(i); }
 // one: a straight pass over the list with no message, which the per-index loop's gathers and error
 // branches cost several times over (validation was 5% of a cylinders / cullide frame's
 // instructions: callgrind, issue #17).
+// Branch-free over the bits, so that the compiler vectorizes it even for baseline x86-64: a
+// component is finite iff its exponent bits are not all ones, and (0, 0, 0, 0) has every component
+// +-0 (the same rules as finite4 and the zero test below).
 bool gl_list_valid(std::span<const Float4> verts) {
-    bool ok = true;
-    for (const Float4& v : verts)
-        ok = ok && finite4(v) && !(v.w == 0.0f && v.x == 0.0f && v.y == 0.0f && v.z == 0.0f);
-    return ok;
+    static_assert(sizeof(Float4) == 16);
+    std::uint32_t bad = 0;
+    for (const Float4& v : verts) {
+        std::uint32_t b[4];
+        std::memcpy(b, &v, sizeof b);
+        const std::uint32_t e = 0x7f800000u;
+        const std::uint32_t nonfinite = static_cast<std::uint32_t>((b[0] & e) == e) | static_cast<std::uint32_t>((b[1] & e) == e) |
+                                        static_cast<std::uint32_t>((b[2] & e) == e) | static_cast<std::uint32_t>((b[3] & e) == e);
+        const std::uint32_t zero = static_cast<std::uint32_t>(((b[0] | b[1] | b[2] | b[3]) & 0x7fffffffu) == 0);
+        bad |= nonfinite | zero;
+    }
+    return bad == 0;
 }
 template <class V>
 bool exact_bounds_list_valid(std::span<const V> verts) {
@@ -95,12 +108,23 @@ bool exact_bounds_list_valid(std::span<const V> verts) {
     }
     return ok;
 }
+// Whether every index is below n (a count of offenders, which vectorizes; a running maximum of
+// unsigned values does not on baseline x86-64, which has no unsigned 32-bit max).
+bool indices_below(std::span<const std::uint32_t> idx, std::size_t n) {
+    if (n > UINT32_MAX) return true;
+    const auto m = static_cast<std::uint32_t>(n);
+    std::uint32_t over = 0;
+    for (const std::uint32_t k : idx) over |= static_cast<std::uint32_t>(k >= m);
+    return over == 0;
+}
 
-// The vertex lists of a batch already found wholly valid. Draws that index one list in many pieces
-// (CULLIDE's sub-objects: 12 of an object's indices per draw) check it once. A whole list costs its
-// length, so it is checked only within an allowance of four vertices per index validated so far in
-// the batch: a batch of small draws into large, alternating lists costs at most a few times the
-// per-index loop, never its list sizes over and over.
+// The vertex lists of a sequence's batches already found wholly valid. Draws that index one list in
+// many pieces (CULLIDE's sub-objects: 12 of an object's indices per draw) check it once; the last
+// kEntries lists are kept, as each CULLIDE pass alternates between its objects' lists (one kept list
+// checked the cloth's two lists twice per pass: 6% of a cloth / rcullide-offset frame, serial). A
+// whole list costs its length, so it is checked only within an allowance of four vertices per index
+// validated so far: small draws into many large lists cost at most a few times the per-index loop,
+// never their list sizes over and over.
 class ListMemo {
    public:
     // Whether `verts` (first vertex `data`, `size` of them) is known or now found valid; `check`
@@ -108,30 +132,56 @@ class ListMemo {
     template <class Check>
     bool valid(const void* data, std::size_t size, std::size_t indices, const Check& check) {
         allowance_ += 4 * indices;
-        if (data == data_ && size <= size_) return true;
+        for (const Entry& e : known_)
+            if (data == e.data && size <= e.size) return true;
         if (size > allowance_) return false;
         allowance_ -= size;
         if (!check()) return false;
-        data_ = data;
-        size_ = size;
+        known_[next_] = {data, size};
+        next_ = (next_ + 1) % kEntries;
         return true;
     }
 
    private:
-    const void* data_ = nullptr;
-    std::size_t size_ = 0;
+    static constexpr std::size_t kEntries = 8;
+    struct Entry {
+        const void* data = nullptr;
+        std::size_t size = 0;
+    };
+    std::array<Entry, kEntries> known_{};
+    std::size_t next_ = 0;
     std::size_t allowance_ = 0;
 };
+
+// The lists of each vertex rule, kept over a sequence's batches.
+struct ListMemos {
+    ListMemo gl, bounds, bounds_d;
+};
+
+Status validate_with(const DepthTarget& target, const CommandBatch& batch, ListMemos& memos);
 }  // namespace
 
 Status validate(const DepthTarget& target, const CommandBatch& batch) {
+    ListMemos memos;
+    return validate_with(target, batch, memos);
+}
+
+SequenceCheck validate_sequence(const DepthTarget& target, std::span<const CommandBatch* const> batches) {
+    ListMemos memos;
+    for (std::size_t k = 0; k < batches.size(); ++k)
+        if (Status s = validate_with(target, *batches[k], memos); !s) return {k, std::move(s)};
+    return {batches.size(), {}};
+}
+
+namespace {
+Status validate_with(const DepthTarget& target, const CommandBatch& batch, ListMemos& memos) {
     if (batch.target_width() != target.width() || batch.target_height() != target.height()) {
         return Error{"batch was built for a " + std::to_string(batch.target_width()) + "x" +
                      std::to_string(batch.target_height()) + " target but the target is " +
                      std::to_string(target.width()) + "x" + std::to_string(target.height())};
     }
     bool active = false;
-    ListMemo gl_lists, bounds_lists, bounds_lists_d;
+    ListMemo &gl_lists = memos.gl, &bounds_lists = memos.bounds, &bounds_lists_d = memos.bounds_d;
     const auto& cmds = batch.commands();
     for (std::size_t i = 0; i < cmds.size(); ++i) {
         const Command& c = cmds[i];
@@ -179,10 +229,8 @@ Status validate(const DepthTarget& target, const CommandBatch& batch) {
                 // shared vertex list may hold others), so a list with an invalid unused vertex is
                 // still accepted, only more slowly.
                 {
-                    std::uint32_t max_index = 0;
-                    for (const std::uint32_t k : idx) max_index = std::max(max_index, k);
                     bool list_ok = false;
-                    if (idx.empty() || max_index < vertex_count) {
+                    if (indices_below(idx, vertex_count)) {
                         if (c.double_input) {
                             const auto verts = c.mesh_d.vertices;
                             list_ok = bounds_lists_d.valid(verts.data(), verts.size(), idx.size(),
@@ -234,6 +282,7 @@ Status validate(const DepthTarget& target, const CommandBatch& batch) {
     if (active) return Error{"the batch ends with a query still active (missing end_query)"};
     return {};
 }
+}  // namespace
 
 }  // namespace detail
 }  // namespace raster

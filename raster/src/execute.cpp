@@ -503,13 +503,15 @@ Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::spa
     if (options.threads < 0)
         return Error{"execute: threads = " + std::to_string(options.threads) +
                      " is out of range: it must be >= 0 (0 = all hardware threads)"};
-    for (std::size_t k = 0; k < batches.size(); ++k) {
-        if (batches[k] == nullptr) return Error{"execute_sequence: batch " + std::to_string(k) + " is null"};
-        if (Status s = detail::validate(target, *batches[k]); !s) {
-            if (batches.size() == 1) return s.error();
-            return Error{"execute_sequence: batch " + std::to_string(k) + ": " + s.error().message};
-        }
+    // The batches in order up to the first null one, then that one: the first problem in order.
+    std::size_t first_null = 0;
+    while (first_null < batches.size() && batches[first_null] != nullptr) ++first_null;
+    if (detail::SequenceCheck c = detail::validate_sequence(target, batches.first(first_null)); !c.status) {
+        if (batches.size() == 1) return c.status.error();
+        return Error{"execute_sequence: batch " + std::to_string(c.batch) + ": " + c.status.error().message};
     }
+    if (first_null < batches.size())
+        return Error{"execute_sequence: batch " + std::to_string(first_null) + " is null"};
     // The buffers below are this thread's: a call from inside `between` would overwrite the
     // running sequence's front end. Refused instead (raster/command_batch.h).
     thread_local bool running = false;

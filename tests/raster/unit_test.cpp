@@ -233,6 +233,58 @@ TEST_CASE("Shared vertex lists: validation names a used bad vertex whatever earl
     CHECK(run(bad_batch, {}, false).first.find("command 8: vertex 3 has w = 2") != std::string::npos);
 }
 
+TEST_CASE("Sequences: every bad vertex rule is named after the list's whole-list check, and the first problem in order") {
+    // The whole-list check (command_batch.cpp's gl_list_valid, run once a list's allowance allows)
+    // must refuse each rule's offence, or the memo would accept the list and a later draw of the
+    // bad vertex would run; lists found valid are kept across a sequence's batches.
+    const int W = 16, H = 16;
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    const std::vector<Float4> bad_vertices = {{nan, 0, 0, 1}, {0, nan, 0, 1},  {0, 0, nan, 1},  {0, 0, 0, nan},
+                                              {inf, 0, 0, 1}, {0, -inf, 0, 1}, {0, 0, inf, 1},  {0, 0, 0, inf},
+                                              {0, 0, 0, 0},   {-0.0f, 0, -0.0f, -0.0f}};
+    const std::vector<std::uint32_t> tri = {0, 1, 2}, uses_bad = {0, 1, 3};
+    raster::DrawState s;
+    s.depth_func = DepthFunc::Always;
+    auto run = [&](std::span<const raster::CommandBatch* const> batches) {
+        auto t = raster::DepthTarget::create(W, H, DepthFormat::D24).value();
+        auto r = raster::execute_sequence(t, batches, raster::ExecuteOptions{1, true});
+        return r.ok() ? std::string{} : r.error().message;
+    };
+    for (std::size_t b = 0; b < bad_vertices.size(); ++b) {
+        CAPTURE(b);
+        const std::vector<Float4> v = {px(1, 1, 0.5f, W, H), px(15, 1, 0.5f, W, H), px(1, 15, 0.5f, W, H),
+                                       bad_vertices[b]};
+        // Batch 0 draws the good vertices often enough for the whole list to be checked; batch 1
+        // then draws the bad one.
+        raster::CommandBatch first(W, H), second(W, H);
+        for (int k = 0; k < 20; ++k) first.draw({v, tri}, s);
+        second.draw({v, uses_bad}, s);
+        const raster::CommandBatch* const both[2] = {&first, &second};
+        const std::string e = run(both);
+        CAPTURE(e);
+        CHECK(e.find("execute_sequence: batch 1: command 0: vertex 3 ") != std::string::npos);
+        CHECK(run(std::span<const raster::CommandBatch* const>(both, 1)).empty());
+    }
+    // Nine lists drawn in turn (more than the memo keeps), the last one's bad vertex used last.
+    std::vector<std::vector<Float4>> lists(9, {px(1, 1, 0.5f, W, H), px(15, 1, 0.5f, W, H), px(1, 15, 0.5f, W, H),
+                                               Float4{0, 0, 0, 0}});
+    raster::CommandBatch many(W, H);
+    for (int round = 0; round < 12; ++round)
+        for (const auto& l : lists) many.draw({l, tri}, s);
+    many.draw({lists.back(), uses_bad}, s);
+    const raster::CommandBatch* const one[1] = {&many};
+    CHECK(run(one).find("command 108: vertex 3 is (0, 0, 0, 0)") != std::string::npos);
+    // The first problem in order: a bad batch before a null one, a null one before a bad one.
+    const std::vector<Float4> good = {px(1, 1, 0.5f, W, H), px(15, 1, 0.5f, W, H), px(1, 15, 0.5f, W, H)};
+    raster::CommandBatch ok_batch(W, H), bad_batch(W, H);
+    ok_batch.draw({good, tri}, s);
+    bad_batch.draw({good, uses_bad}, s);
+    const raster::CommandBatch* const bad_then_null[3] = {&ok_batch, &bad_batch, nullptr};
+    CHECK(run(bad_then_null).find("execute_sequence: batch 1: command 0: index 3 at position 2") != std::string::npos);
+    const raster::CommandBatch* const null_then_bad[3] = {&ok_batch, nullptr, &bad_batch};
+    CHECK(run(null_then_bad) == "execute_sequence: batch 1 is null");
+}
+
 TEST_CASE("next_down / next_up (float_step.h) equal std::nextafter on every exponent, zeros, subnormals and the extremes") {
     raster_test::SplitMix64 rng(0x57e9u);
     std::vector<float> values = {0.0f, -0.0f, std::numeric_limits<float>::denorm_min(),
