@@ -137,21 +137,34 @@ namespace {
 
 // The tiled executor's phases, in order: draws(), front_end(), bin(), then shade() per tile.
 
-// The draw commands of a sequence of batches (execute: one batch), in order: batch k's draws are
-// [first[k], first[k + 1]).
+// The front end's unit of parallel work: with several threads, a GL-exact draw of more than
+// kFrontEndPiece triangles is cut into entries (pieces) of kFrontEndPiece triangles.
+constexpr std::size_t kFrontEndPiece = 2048;
+
+// The draw commands of a sequence of batches (execute: one batch), in order: batch k's entries are
+// [first[k], first[k + 1]). An entry is a draw command, or with several threads one piece of a big
+// GL-exact draw (a run of its index list: the pieces of a draw follow one another with the draw's
+// state and query, so their triangles keep the draw's order and every result is the same as with
+// the draw whole). Each entry's triangles are set up into their own list on some thread; pieces
+// used to be set up apart and then appended to their draw's list on the calling thread, a serial
+// copy (with reallocation) of up to the whole list: 10% of the calling thread's samples in a leaves
+// / qcullide-gl frame at 2 threads (perf, DWARF call graphs).
 struct Draws {
-    std::vector<const Command*> cmd;    // per draw: its command
-    std::vector<std::uint32_t> index;   // per draw: the command's index in its batch
-    std::vector<std::uint32_t> query;   // per draw: its batch's query active at it, or kNoQuery
-    std::vector<RasterRules> rules;     // per draw: its batch's rules
+    std::vector<const Command*> cmd;    // per entry: its command
+    std::vector<std::uint32_t> index;   // per entry: the command's index in its batch
+    std::vector<std::uint32_t> query;   // per entry: its batch's query active at it, or kNoQuery
+    std::vector<RasterRules> rules;     // per entry: its batch's rules
+    std::vector<std::size_t> k0, k1;    // per entry: its part [k0, k1) of the command's index list
     std::vector<std::size_t> first;     // per batch, and the total at the end
 };
 
-void draws(std::span<const CommandBatch* const> batches, Draws& d) {
+void draws(std::span<const CommandBatch* const> batches, int threads, Draws& d) {
     d.cmd.clear();
     d.index.clear();
     d.query.clear();
     d.rules.clear();
+    d.k0.clear();
+    d.k1.clear();
     d.first.clear();
     for (const CommandBatch* batch : batches) {
         d.first.push_back(d.cmd.size());
@@ -163,10 +176,18 @@ void draws(std::span<const CommandBatch* const> batches, Draws& d) {
             } else if (cmds[i].kind == Command::Kind::EndQuery) {
                 active = kNoQuery;
             } else {
-                d.cmd.push_back(&cmds[i]);
-                d.index.push_back(static_cast<std::uint32_t>(i));
-                d.query.push_back(active);
-                d.rules.push_back(batch->rules());
+                const Command& c = cmds[i];
+                const std::size_t n = c.double_input ? c.mesh_d.indices.size() : c.mesh.indices.size();
+                const bool split = threads > 1 && c.state.mode == RasterMode::GLExact && !c.double_input &&
+                                   n > 3 * kFrontEndPiece;
+                for (std::size_t k = 0; k == 0 || (split && k < n); k += 3 * kFrontEndPiece) {
+                    d.cmd.push_back(&c);
+                    d.index.push_back(static_cast<std::uint32_t>(i));
+                    d.query.push_back(active);
+                    d.rules.push_back(batch->rules());
+                    d.k0.push_back(k);
+                    d.k1.push_back(split ? std::min(n, k + 3 * kFrontEndPiece) : n);
+                }
             }
         }
     }
@@ -183,14 +204,19 @@ struct SetupDraws {
     std::vector<CullFace> bin_cull;
     std::vector<CullFace> setup_cull;
     std::vector<std::vector<detail::SetupTri>> tris;
+    // The pieces' lists (Draws), by piece number in the call: a sequence's big draws come back call
+    // after call, so each piece number keeps a list of about its size (a list per entry index was
+    // reallocated, and its new pages faulted in, in almost every call).
+    std::vector<std::vector<detail::SetupTri>> piece_tris;
+    // Per entry with a list of its own: tris[d], or its piece's list.
+    std::vector<std::vector<detail::SetupTri>*> list;
+    [[nodiscard]] const std::vector<detail::SetupTri>& tris_of(std::size_t d) const { return *list[src[d]]; }
     std::vector<std::vector<detail::BoundsTri>> bounds;
     std::vector<std::vector<detail::BoundsVertex>> pool;
 };
 
-// Front end, per draw in parallel; each draw's triangles land in its own list so the order is the
-// command order whatever the schedule. With several threads, a big GL-exact draw is split into
-// pieces of kFrontEndPiece triangles; piece 0 fills the draw's list, the others their own lists,
-// appended after in piece order (so the list is the same as one serial pass, whatever the count).
+// Front end, per entry in parallel; each entry's triangles land in its own list, so the order is
+// the command order whatever the schedule (see Draws for the pieces of big draws).
 // Resizes a list of lists to n and empties the first n (capacity kept: see Scratch).
 template <class T>
 void reset_lists(std::vector<std::vector<T>>& lists, std::size_t n) {
@@ -241,7 +267,8 @@ void share_setup(const DepthTarget& target, const Draws& draws, SetupDraws& out,
         out.setup_cull[d] = c.state.cull_face;
         if (c.state.mode == RasterMode::ExactBounds || c.double_input) continue;
         const detail::FrontEndParams p = params_for(target, draws.rules[d], c.state);
-        const SetupKey key{c.mesh.vertices.data(), c.mesh.vertices.size(), c.mesh.indices.data(), c.mesh.indices.size(),
+        const SetupKey key{c.mesh.vertices.data(), c.mesh.vertices.size(), c.mesh.indices.data() + draws.k0[d],
+                           draws.k1[d] - draws.k0[d],
                            p.viewport.x, p.viewport.y, p.viewport.width, p.viewport.height, p.front_face, p.rules};
         const std::uint32_t src = index.try_emplace(key, static_cast<std::uint32_t>(d)).first->second;
         out.src[d] = src;
@@ -254,31 +281,28 @@ void share_setup(const DepthTarget& target, const Draws& draws, SetupDraws& out,
 }
 
 void front_end(const DepthTarget& target, const Draws& draws, int threads, SetupDraws& out,
-               std::vector<std::vector<detail::SetupTri>>& piece_out) {
+               std::vector<std::uint32_t>& own) {
     const std::size_t n_draws = draws.cmd.size();
     reset_lists(out.tris, n_draws);
     reset_lists(out.bounds, n_draws);
     reset_lists(out.pool, n_draws);
-    constexpr std::size_t kFrontEndPiece = 2048;
-    struct Piece {
-        std::uint32_t draw;
-        std::size_t k0, k1;  // index range [k0, k1) of the draw's index list (whole triangles)
-    };
-    std::vector<Piece> pieces;
-    for (std::size_t d = 0; d < n_draws; ++d) {
-        if (out.src[d] != d) continue;  // shares an earlier draw's list
+    own.clear();  // the entries with a list of their own
+    const auto is_piece = [&](std::size_t d) {
         const Command& c = *draws.cmd[d];
-        const std::size_t n = c.state.mode == RasterMode::ExactBounds ? 0 : c.mesh.indices.size() / 3 * 3;
-        if (threads == 1 || n <= 3 * kFrontEndPiece) {
-            pieces.push_back({static_cast<std::uint32_t>(d), 0, n});
-            continue;
-        }
-        for (std::size_t k = 0; k < n; k += 3 * kFrontEndPiece)
-            pieces.push_back({static_cast<std::uint32_t>(d), k, std::min(n, k + 3 * kFrontEndPiece)});
+        return !c.double_input && draws.k1[d] - draws.k0[d] != c.mesh.indices.size();
+    };
+    std::size_t pieces = 0;
+    for (std::size_t d = 0; d < n_draws; ++d) {
+        if (out.src[d] != d) continue;
+        own.push_back(static_cast<std::uint32_t>(d));
+        pieces += is_piece(d) ? 1 : 0;
     }
-    reset_lists(piece_out, pieces.size());
-    detail::parallel_for(threads, pieces.size(), [&](std::size_t j) {
-        const std::size_t d = pieces[j].draw;
+    reset_lists(out.piece_tris, pieces);  // sized before any list's address is taken
+    out.list.resize(n_draws);
+    pieces = 0;
+    for (const std::uint32_t d : own) out.list[d] = is_piece(d) ? &out.piece_tris[pieces++] : &out.tris[d];
+    detail::parallel_for(threads, own.size(), [&](std::size_t j) {
+        const std::size_t d = own[j];
         const Command& c = *draws.cmd[d];
         detail::FrontEndParams p = params_for(target, draws.rules[d], c.state);
         p.cull_face = out.setup_cull[d];  // None when draws of other culling share this list
@@ -286,15 +310,11 @@ void front_end(const DepthTarget& target, const Draws& draws, int threads, Setup
             setup_bounds_draw(p, c, draws.index[d], out.bounds[d], out.pool[d]);
             return;
         }
-        const auto& idx = c.mesh.indices;
-        const auto& vtx = c.mesh.vertices;
-        auto& list = pieces[j].k0 == 0 ? out.tris[d] : piece_out[j];
-        list.reserve(list.size() + (pieces[j].k1 - pieces[j].k0) / 3);  // one SetupTri per unclipped triangle
-        detail::setup_range(p, vtx, idx.subspan(pieces[j].k0, pieces[j].k1 - pieces[j].k0), draws.index[d], list);
+        const std::size_t k0 = draws.k0[d], n = (draws.k1[d] - k0) / 3 * 3;
+        auto& list = *out.list[d];
+        list.reserve(n / 3);  // one SetupTri per unclipped triangle
+        detail::setup_range(p, c.mesh.vertices, c.mesh.indices.subspan(k0, n), draws.index[d], list);
     });
-    for (std::size_t j = 0; j < pieces.size(); ++j)
-        if (pieces[j].k0 != 0)
-            out.tris[pieces[j].draw].insert(out.tris[pieces[j].draw].end(), piece_out[j].begin(), piece_out[j].end());
 }
 
 // The target cut into kTileSize squares, row-major.
@@ -365,7 +385,7 @@ void bin(const SetupDraws& setup, std::size_t d0, std::size_t d1, const Tiles& t
             }
         };
         for (std::size_t d = d0; d < d1; ++d) {
-            const auto& tris = setup.tris[setup.src[d]];
+            const auto& tris = setup.tris_of(d);
             const CullFace cull = setup.bin_cull[d];
             if (cull == CullFace::None)
                 bin_list.template operator()<false>(d, tris, false);
@@ -406,7 +426,7 @@ void draw_infos(const CommandBatch& batch, const Draws& draws, std::size_t d0, s
         info.write = c.state.depth_write;
         info.any_only = info.query != kNoQuery && !c.state.depth_write &&
                         query_kinds[info.query] == QueryKind::AnySamplesPassed;
-        info.tris = info.exact_bounds ? nullptr : setup.tris[setup.src[d]].data();
+        info.tris = info.exact_bounds ? nullptr : setup.tris_of(d).data();
         info.kernel = info.exact_bounds
                           ? nullptr
                           : detail::select_rect_kernel({format, c.state.depth_func, c.state.depth_write},
@@ -533,7 +553,7 @@ Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::spa
     struct Scratch {
         Draws draw_list;
         SetupDraws setup;
-        std::vector<std::vector<detail::SetupTri>> piece_out;
+        std::vector<std::uint32_t> own_setup;
         std::vector<std::vector<Ref>> bins;
         std::vector<std::vector<std::pair<std::uint32_t, std::uint64_t>>> tile_counts;
         std::vector<std::atomic<bool>> answered;
@@ -546,9 +566,9 @@ Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::spa
     // One front end for the whole sequence: a triangle list is set up once for every draw of any
     // batch with the same spans and front-end state (share_setup). Every batch's spans are alive
     // and unchanged for the whole call (the lifetime rule of raster/types.h), so this is exact.
-    draws(batches, draw_list);
+    draws(batches, threads, draw_list);
     share_setup(target, draw_list, scratch.setup, scratch.setup_index);
-    front_end(target, draw_list, threads, scratch.setup, scratch.piece_out);
+    front_end(target, draw_list, threads, scratch.setup, scratch.own_setup);
     const SetupDraws& setup = scratch.setup;
     const Tiles tiles{(target.width() + kTileSize - 1) / kTileSize, (target.height() + kTileSize - 1) / kTileSize};
     static_assert(kTileSize == detail::kHizTile, "HizTile holds the 8 x 8 blocks of one executor tile");
