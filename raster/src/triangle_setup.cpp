@@ -3,6 +3,7 @@
 #include "pipeline.h"
 
 #include "float_step.h"
+#include "setup_simd.h"
 
 #include "raster/command_batch.h"
 
@@ -125,31 +126,42 @@ ClipVertex interpolate(const ViewportXform& xf, float t, const ClipVertex& out, 
     return d;
 }
 
-// llvmpipe's setup of one (post-clip) triangle in window coordinates. A template on the rules, so
-// each rule set's front end is compiled with its choices as constants (the GL path is as it was).
-template <RasterRules Rules>
-void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const ClipVertex* v1, const ClipVertex* v2,
-                           std::uint32_t draw, std::vector<SetupTri>& out) {
+struct PlaneCoeffs {
+    float z0, dzdx, dzdy;
+};
+
+// The depth plane from the float window positions, in llvmpipe's operation order (setup_avx2.cpp
+// computes the same for 8 triangles at once).
+PlaneCoeffs depth_plane(const ClipVertex* v0, const ClipVertex* v1, const ClipVertex* v2) {
+    const float x0c = v0->win[0] - 0.5f;
+    const float y0c = v0->win[1] - 0.5f;
+    const float dx01 = v0->win[0] - v1->win[0];
+    const float dy01 = v0->win[1] - v1->win[1];
+    const float dx20 = v2->win[0] - v0->win[0];
+    const float dy20 = v2->win[1] - v0->win[1];
+    const float e = dx01 * dy20;
+    const float f = dy01 * dx20;
+    const float ooa = 1.0f / (e - f);
+    const float dy20_ooa = dy20 * ooa;
+    const float dy01_ooa = dy01 * ooa;
+    const float dx20_ooa = dx20 * ooa;
+    const float dx01_ooa = dx01 * ooa;
+    const float da01 = v0->win[2] - v1->win[2];
+    const float da20 = v2->win[2] - v0->win[2];
+    const float dadx = da01 * dy20_ooa - da20 * dy01_ooa;
+    const float dady = da20 * dx01_ooa - da01 * dx20_ooa;
+    const float a0 = v0->win[2] - (dadx * x0c + dady * y0c);
+    return {a0, dadx, dady};
+}
+
+// llvmpipe's setup of one (post-clip) triangle after the snap: x, y are its corners in 16.8 in the
+// given order, plane_of(swapped) its depth plane for the given order (false) or for the order that
+// setup uses for a negative triangle (true: see below). A template on the rules, so each rule set's
+// front end is compiled with its choices as constants (the GL path is as it was).
+template <RasterRules Rules, class PlaneOf>
+inline void setup_snapped(const FrontEndParams& p, int64_t* x, int64_t* y, const PlaneOf& plane_of,
+                          std::uint32_t draw, std::vector<SetupTri>& out) {
     constexpr RuleSet rules = rule_set(Rules);
-    // Window positions outside the fixed-point range are dropped. Clipping (no guard band) keeps a
-    // finite vertex inside the viewport, so only two things put one outside: a clipped vertex with
-    // w = 0 (1/w overflows, NaN or infinite position) and the rounding of the clip interpolation
-    // on coordinates near 2^100 (errors of 2^75 px and more). llvmpipe converts such a position to
-    // 0x80000000 (cvtps2dq's integer indefinite) and rasterizes the edges that make; our 64-bit
-    // edge functions would overflow (undefined, and the kernels then disagreed: the raster_gl_exact
-    // fuzz finding of session 7). |snapped| < 2^30 keeps every product of setup and the kernels
-    // within 62 bits; it is 4,194,304 px, far beyond any target (kMaxTargetSize) or viewport.
-    // docs/raster-known-differences.md, "Window positions out of range".
-    const auto in_range = [](float w) { return std::fabs((w - 0.5f) * kFixedOne) < 0x1p30f; };  // NaN: false
-    if (!(in_range(v0->win[0]) && in_range(v0->win[1]) && in_range(v1->win[0]) && in_range(v1->win[1]) &&
-          in_range(v2->win[0]) && in_range(v2->win[1])))
-        return;
-    // Snap to 16.8 after moving the pixel centre to the integer lattice (round half to even, as
-    // cvtps2dq does in the default rounding mode).
-    // (|value| < 2^30 by in_range: lrint32's cvtss2si is exact lrint there.)
-    auto snap = [](float w) { return static_cast<int64_t>(lrint32((w - 0.5f) * kFixedOne)); };
-    int64_t x[3] = {snap(v0->win[0]), snap(v1->win[0]), snap(v2->win[0])};
-    int64_t y[3] = {snap(v0->win[1]), snap(v1->win[1]), snap(v2->win[1])};
     // llvmpipe's area: positive is clockwise in GL window coordinates (y up).
     const int64_t area = (x[0] - x[1]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[0] - y[1]);
     if (area == 0) return;
@@ -163,10 +175,8 @@ void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const 
     // Setup works on llvmpipe's positive orientation; a negative triangle swaps vertices 0 and 1
     // (provoking vertex last) or 1 and 2 (provoking vertex first), which also decides the vertex
     // order of the depth plane below.
-    const ClipVertex* v[3] = {v0, v1, v2};
     if (!lp_positive) {
         const int a = rules.provoking_first ? 1 : 0;
-        std::swap(v[a], v[a + 1]);
         std::swap(x[a], x[a + 1]);
         std::swap(y[a], y[a + 1]);
     }
@@ -207,28 +217,10 @@ void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const 
         t.dcdy[i] = dcdy;
     }
 
-    // Depth plane from the float window positions, in llvmpipe's operation order.
-    const float x0c = v[0]->win[0] - 0.5f;
-    const float y0c = v[0]->win[1] - 0.5f;
-    const float dx01 = v[0]->win[0] - v[1]->win[0];
-    const float dy01 = v[0]->win[1] - v[1]->win[1];
-    const float dx20 = v[2]->win[0] - v[0]->win[0];
-    const float dy20 = v[2]->win[1] - v[0]->win[1];
-    const float e = dx01 * dy20;
-    const float f = dy01 * dx20;
-    const float ooa = 1.0f / (e - f);
-    const float dy20_ooa = dy20 * ooa;
-    const float dy01_ooa = dy01 * ooa;
-    const float dx20_ooa = dx20 * ooa;
-    const float dx01_ooa = dx01 * ooa;
-    const float da01 = v[0]->win[2] - v[1]->win[2];
-    const float da20 = v[2]->win[2] - v[0]->win[2];
-    const float dadx = da01 * dy20_ooa - da20 * dy01_ooa;
-    const float dady = da20 * dx01_ooa - da01 * dx20_ooa;
-    const float a0 = v[0]->win[2] - (dadx * x0c + dady * y0c);
-    t.z0 = a0;
-    t.dzdx = dadx;
-    t.dzdy = dady;
+    const PlaneCoeffs plane = plane_of(!lp_positive);
+    t.z0 = plane.z0;
+    t.dzdx = plane.dzdx;
+    t.dzdy = plane.dzdy;
     t.draw = draw;
     t.front = front;
     // SetupTri::fits32 from the snapped extents (two products; an exact bound over the box's
@@ -242,6 +234,62 @@ void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const 
         t.fits32 = span_y * (span_x + 2048) + span_x * (span_y + 256) + 1 < (int64_t{1} << 31);
     }
     out.push_back(t);
+}
+
+// llvmpipe's setup of one (post-clip) triangle in window coordinates.
+template <RasterRules Rules>
+void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const ClipVertex* v1, const ClipVertex* v2,
+                           std::uint32_t draw, std::vector<SetupTri>& out) {
+    constexpr RuleSet rules = rule_set(Rules);
+    // Window positions outside the fixed-point range are dropped. Clipping (no guard band) keeps a
+    // finite vertex inside the viewport, so only two things put one outside: a clipped vertex with
+    // w = 0 (1/w overflows, NaN or infinite position) and the rounding of the clip interpolation
+    // on coordinates near 2^100 (errors of 2^75 px and more). llvmpipe converts such a position to
+    // 0x80000000 (cvtps2dq's integer indefinite) and rasterizes the edges that make; our 64-bit
+    // edge functions would overflow (undefined, and the kernels then disagreed: the raster_gl_exact
+    // fuzz finding of session 7). |snapped| < 2^30 keeps every product of setup and the kernels
+    // within 62 bits; it is 4,194,304 px, far beyond any target (kMaxTargetSize) or viewport.
+    // docs/raster-known-differences.md, "Window positions out of range".
+    const auto in_range = [](float w) { return std::fabs((w - 0.5f) * kFixedOne) < 0x1p30f; };  // NaN: false
+    if (!(in_range(v0->win[0]) && in_range(v0->win[1]) && in_range(v1->win[0]) && in_range(v1->win[1]) &&
+          in_range(v2->win[0]) && in_range(v2->win[1])))
+        return;
+    // Snap to 16.8 after moving the pixel centre to the integer lattice (round half to even, as
+    // cvtps2dq does in the default rounding mode).
+    // (|value| < 2^30 by in_range: lrint32's cvtss2si is exact lrint there.)
+    auto snap = [](float w) { return static_cast<int64_t>(lrint32((w - 0.5f) * kFixedOne)); };
+    int64_t x[3] = {snap(v0->win[0]), snap(v1->win[0]), snap(v2->win[0])};
+    int64_t y[3] = {snap(v0->win[1]), snap(v1->win[1]), snap(v2->win[1])};
+    setup_snapped<Rules>(
+        p, x, y,
+        [&](bool swapped) {
+            if (!swapped) return depth_plane(v0, v1, v2);
+            return rules.provoking_first ? depth_plane(v0, v2, v1) : depth_plane(v1, v0, v2);
+        },
+        draw, out);
+}
+
+// Lane t of setup_lanes8: setup_window_triangle's result from the lanes' snap and planes.
+template <RasterRules Rules>
+void setup_lane(const FrontEndParams& p, const SetupLanes8& lanes, int t, std::uint32_t draw,
+                std::vector<SetupTri>& out) {
+    if (((lanes.in_range >> t) & 1u) == 0) return;
+    int64_t x[3] = {lanes.sx[0][t], lanes.sx[1][t], lanes.sx[2][t]};
+    int64_t y[3] = {lanes.sy[0][t], lanes.sy[1][t], lanes.sy[2][t]};
+    setup_snapped<Rules>(
+        p, x, y,
+        [&](bool swapped) {
+            const int o = swapped ? 1 : 0;
+            return PlaneCoeffs{lanes.z0[o][t], lanes.dzdx[o][t], lanes.dzdy[o][t]};
+        },
+        draw, out);
+}
+
+// Whether setup runs its float part 8 triangles at a time (setup_avx2.cpp): the AVX2 kernel's
+// condition, read once.
+bool simd_setup() {
+    static const bool on = kernel_avx2_available() && simd_allowed_by_environment();
+    return on;
 }
 
 // The rest of setup_triangle_for, from vertices already through the clip test (masks m0..m2) and the
@@ -341,19 +389,61 @@ template <RasterRules Rules>
 void setup_range_for(const FrontEndParams& params, std::span<const Float4> vertices,
                      std::span<const std::uint32_t> indices, std::uint32_t draw, std::vector<SetupTri>& out) {
     constexpr RuleSet rules = rule_set(Rules);
+    static_assert(kFusedViewport, "setup_avx2.cpp's viewport is the fused one");
+    static_assert(sizeof(Float4) == 4 * sizeof(float), "corners are read as 4 floats");
     const std::size_t n = indices.size() / 3 * 3;
+    const bool simd = simd_setup();
+    const ViewportXform xf = make_xform(rules, params.viewport);
     if (n < vertices.size()) {  // a few triangles of a large list (a sub-object's draw): per corner
-        for (std::size_t k = 0; k < n; k += 3)
+        std::size_t k = 0;
+        // Groups of 8 triangles: the clip test, the viewport, the snap and the depth planes for all
+        // 8 at once, then each triangle in order: a clipped one through the scalar front end (as
+        // ever), the others' setup from the lanes (the same values: setup_avx2.cpp).
+        if (simd) {
+            SetupLanes8 lanes;
+            const float* corners[24];
+            for (; k + 24 <= n; k += 24) {
+                for (std::size_t j = 0; j < 24; ++j) corners[j] = &vertices[indices[k + j]].x;
+                viewport_lanes8_avx2(lanes, corners, xf.scale, xf.translate, rules.half_z);
+                setup_lanes8_avx2(lanes, rules.provoking_first);
+                for (int t = 0; t < 8; ++t) {
+                    const std::size_t c = k + 3 * static_cast<std::size_t>(t);
+                    if ((lanes.clipped >> t) & 1u)
+                        setup_triangle_for<Rules>(params, vertices[indices[c]], vertices[indices[c + 1]],
+                                                  vertices[indices[c + 2]], draw, out);
+                    else
+                        setup_lane<Rules>(params, lanes, t, draw, out);
+                }
+            }
+        }
+        for (; k < n; k += 3)
             setup_triangle_for<Rules>(params, vertices[indices[k]], vertices[indices[k + 1]], vertices[indices[k + 2]],
                                       draw, out);
         return;
     }
     // Each vertex through the clip test and the viewport once. An unused vertex of the list may be
     // anything (validation checks only the vertices that triangles use): its values are never read.
-    const ViewportXform xf = make_xform(rules, params.viewport);
     thread_local std::vector<TransformedVertex> cache;
     cache.resize(vertices.size());
-    for (std::size_t i = 0; i < vertices.size(); ++i) {
+    std::size_t i0 = 0;
+    if (simd) {  // 8 vertices at a time (setup_avx2.cpp: the same tests and operations)
+        float win[3][8];
+        std::uint32_t mask[8];
+        for (; i0 + 8 <= vertices.size(); i0 += 8) {
+            vertices8_avx2(&vertices[i0].x, xf.scale, xf.translate, rules.half_z, win, mask);
+            for (std::size_t t = 0; t < 8; ++t) {
+                const Float4& p = vertices[i0 + t];
+                TransformedVertex& tv = cache[i0 + t];
+                tv.v.clip[0] = p.x;
+                tv.v.clip[1] = p.y;
+                tv.v.clip[2] = p.z;
+                tv.v.clip[3] = p.w;
+                for (int c = 0; c < 3; ++c) tv.v.win[c] = win[c][t];
+                tv.mask = mask[t];
+            }
+        }
+    }
+    for (std::size_t i = i0; i < vertices.size(); ++i) {
         const Float4& p = vertices[i];
         TransformedVertex& t = cache[i];
         t.v.clip[0] = p.x;
@@ -363,7 +453,30 @@ void setup_range_for(const FrontEndParams& params, std::span<const Float4> verti
         t.mask = clip_mask<rules.half_z>(t.v.clip);
         shader_viewport(xf, t.v);
     }
-    for (std::size_t k = 0; k < n; k += 3) {
+    std::size_t k = 0;
+    if (simd) {  // groups of 8 unclipped triangles' snap and planes at once, as above
+        SetupLanes8 lanes;
+        for (; k + 24 <= n; k += 24) {
+            std::uint32_t clipped = 0;
+            for (int t = 0; t < 8; ++t) {
+                for (int j = 0; j < 3; ++j) {
+                    const TransformedVertex& v = cache[indices[k + 3 * static_cast<std::size_t>(t) + static_cast<std::size_t>(j)]];
+                    for (int c = 0; c < 3; ++c) lanes.win[j][c][t] = v.v.win[c];
+                    clipped |= v.mask != 0 ? (1u << t) : 0u;
+                }
+            }
+            setup_lanes8_avx2(lanes, rules.provoking_first);
+            for (int t = 0; t < 8; ++t) {
+                const std::size_t c = k + 3 * static_cast<std::size_t>(t);
+                const TransformedVertex &a = cache[indices[c]], &b = cache[indices[c + 1]], &d = cache[indices[c + 2]];
+                if ((clipped >> t) & 1u)
+                    setup_transformed<Rules>(params, xf, &a.v, &b.v, &d.v, a.mask, b.mask, d.mask, draw, out);
+                else
+                    setup_lane<Rules>(params, lanes, t, draw, out);
+            }
+        }
+    }
+    for (; k < n; k += 3) {
         const TransformedVertex &a = cache[indices[k]], &b = cache[indices[k + 1]], &c = cache[indices[k + 2]];
         setup_transformed<Rules>(params, xf, &a.v, &b.v, &c.v, a.mask, b.mask, c.mask, draw, out);
     }

@@ -1,0 +1,174 @@
+// setup_avx2.cpp: the float part of GL-exact triangle setup for 8 triangles at once (AVX2 + FMA),
+// for the triangles that need no clipping. CMake compiles this file alone with -mavx2 -mfma
+// -ffp-contract=off (x86-64 GCC/Clang, RASTER_KERNEL_AVX2=1); triangle_setup.cpp calls it only when
+// kernel_avx2_available() says so. Elsewhere it builds to a stub.
+//
+// Why: a triangle's setup is a chain of dependent float operations with a division per corner
+// (1/w through the viewport) and one for the depth plane; one triangle at a time, those chains were
+// most of setup's time on small triangles (raster_bench SmallTris: setup 29% and the per-corner
+// viewport 8% at 2 threads). Eight triangles in the lanes of one register run them side by side.
+//
+// Every operation is the scalar code's (triangle_setup.cpp) on the same floats, in the same order,
+// each correctly rounded by IEEE: division, multiplication, subtraction, and the viewport's one
+// fused multiply-add (std::fma there, _mm256_fmadd_ps here); -ffp-contract=off keeps the compiler
+// from fusing the others, as the scalar code is never fused on x86-64. The snap to 16.8 is cvtps2dq
+// (the scalar code's cvtss2si: the same MXCSR rounding) behind the same range test. So each lane's
+// values are the scalar code's bits; tests/raster/simd_test.cpp compares whole SetupTri lists.
+#include "setup_simd.h"
+
+#if defined(RASTER_KERNEL_AVX2)
+#include <immintrin.h>
+#endif
+
+namespace raster::detail {
+
+#if defined(RASTER_KERNEL_AVX2)
+namespace {
+
+struct Plane8 {
+    __m256 z0, dzdx, dzdy;
+};
+
+// The depth plane of triangles (v0, v1, v2) in llvmpipe's operation order (depth_plane).
+Plane8 plane8(const __m256* v0, const __m256* v1, const __m256* v2) {
+    const __m256 half = _mm256_set1_ps(0.5f);
+    const __m256 x0c = _mm256_sub_ps(v0[0], half);
+    const __m256 y0c = _mm256_sub_ps(v0[1], half);
+    const __m256 dx01 = _mm256_sub_ps(v0[0], v1[0]);
+    const __m256 dy01 = _mm256_sub_ps(v0[1], v1[1]);
+    const __m256 dx20 = _mm256_sub_ps(v2[0], v0[0]);
+    const __m256 dy20 = _mm256_sub_ps(v2[1], v0[1]);
+    const __m256 e = _mm256_mul_ps(dx01, dy20);
+    const __m256 f = _mm256_mul_ps(dy01, dx20);
+    const __m256 ooa = _mm256_div_ps(_mm256_set1_ps(1.0f), _mm256_sub_ps(e, f));
+    const __m256 dy20_ooa = _mm256_mul_ps(dy20, ooa);
+    const __m256 dy01_ooa = _mm256_mul_ps(dy01, ooa);
+    const __m256 dx20_ooa = _mm256_mul_ps(dx20, ooa);
+    const __m256 dx01_ooa = _mm256_mul_ps(dx01, ooa);
+    const __m256 da01 = _mm256_sub_ps(v0[2], v1[2]);
+    const __m256 da20 = _mm256_sub_ps(v2[2], v0[2]);
+    const __m256 dadx = _mm256_sub_ps(_mm256_mul_ps(da01, dy20_ooa), _mm256_mul_ps(da20, dy01_ooa));
+    const __m256 dady = _mm256_sub_ps(_mm256_mul_ps(da20, dx01_ooa), _mm256_mul_ps(da01, dx20_ooa));
+    const __m256 a0 =
+        _mm256_sub_ps(v0[2], _mm256_add_ps(_mm256_mul_ps(dadx, x0c), _mm256_mul_ps(dady, y0c)));
+    return {a0, dadx, dady};
+}
+
+}  // namespace
+
+bool setup_lanes8_avx2(SetupLanes8& io, bool provoking_first) {
+    __m256 v[3][3];
+    for (int k = 0; k < 3; ++k)
+        for (int c = 0; c < 3; ++c) v[k][c] = _mm256_loadu_ps(io.win[k][c]);
+    // Range test and 16.8 snap of x and y: |(w - 0.5) * 256| < 2^30 (false for NaN), then
+    // cvtps2dq of the same product.
+    const __m256 half = _mm256_set1_ps(0.5f), fixed_one = _mm256_set1_ps(256.0f);
+    const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+    const __m256 limit = _mm256_set1_ps(0x1p30f);
+    __m256 ok = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+    for (int k = 0; k < 3; ++k) {
+        for (int c = 0; c < 2; ++c) {
+            const __m256 s = _mm256_mul_ps(_mm256_sub_ps(v[k][c], half), fixed_one);
+            ok = _mm256_and_ps(ok, _mm256_cmp_ps(_mm256_and_ps(s, abs_mask), limit, _CMP_LT_OQ));
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(c == 0 ? io.sx[k] : io.sy[k]), _mm256_cvtps_epi32(s));
+        }
+    }
+    io.in_range = static_cast<std::uint32_t>(_mm256_movemask_ps(ok));
+    // The plane for the vertex order as given and for setup's swap of a negative triangle:
+    // vertices 0 and 1 (provoking vertex last) or 1 and 2 (provoking vertex first).
+    const Plane8 given = plane8(v[0], v[1], v[2]);
+    const Plane8 swapped = provoking_first ? plane8(v[0], v[2], v[1]) : plane8(v[1], v[0], v[2]);
+    _mm256_storeu_ps(io.z0[0], given.z0);
+    _mm256_storeu_ps(io.dzdx[0], given.dzdx);
+    _mm256_storeu_ps(io.dzdy[0], given.dzdy);
+    _mm256_storeu_ps(io.z0[1], swapped.z0);
+    _mm256_storeu_ps(io.dzdx[1], swapped.dzdx);
+    _mm256_storeu_ps(io.dzdy[1], swapped.dzdy);
+    return true;
+}
+
+namespace {
+
+// Eight rows of (x, y, z, w) as four registers of x, y, z and w.
+void transpose8x4(const __m128* r, __m256* a) {
+    const __m256 r04 = _mm256_insertf128_ps(_mm256_castps128_ps256(r[0]), r[4], 1);
+        const __m256 r15 = _mm256_insertf128_ps(_mm256_castps128_ps256(r[1]), r[5], 1);
+        const __m256 r26 = _mm256_insertf128_ps(_mm256_castps128_ps256(r[2]), r[6], 1);
+        const __m256 r37 = _mm256_insertf128_ps(_mm256_castps128_ps256(r[3]), r[7], 1);
+        const __m256 t0 = _mm256_unpacklo_ps(r04, r15);  // x0 x1 y0 y1 | x4 x5 y4 y5
+        const __m256 t1 = _mm256_unpackhi_ps(r04, r15);  // z0 z1 w0 w1 | z4 z5 w4 w5
+        const __m256 t2 = _mm256_unpacklo_ps(r26, r37);  // x2 x3 y2 y3 | x6 x7 y6 y7
+        const __m256 t3 = _mm256_unpackhi_ps(r26, r37);  // z2 z3 w2 w3 | z6 z7 w6 w7
+    a[0] = _mm256_shuffle_ps(t0, t2, 0x44);
+    a[1] = _mm256_shuffle_ps(t0, t2, 0xee);
+    a[2] = _mm256_shuffle_ps(t1, t3, 0x44);
+    a[3] = _mm256_shuffle_ps(t1, t3, 0xee);
+}
+
+// clip_mask's six tests in its bit order (ordered compares: false for NaN, as there), one
+// movemask per bit.
+void clip_bits8(const __m256* a, bool half_z, int bits[6]) {
+    const __m256 zero = _mm256_setzero_ps();
+    bits[0] = _mm256_movemask_ps(_mm256_cmp_ps(a[0], a[3], _CMP_GT_OQ));
+    bits[1] = _mm256_movemask_ps(_mm256_cmp_ps(zero, _mm256_add_ps(a[0], a[3]), _CMP_GT_OQ));
+    bits[2] = _mm256_movemask_ps(_mm256_cmp_ps(a[1], a[3], _CMP_GT_OQ));
+    bits[3] = _mm256_movemask_ps(_mm256_cmp_ps(zero, _mm256_add_ps(a[1], a[3]), _CMP_GT_OQ));
+    bits[4] = _mm256_movemask_ps(half_z ? _mm256_cmp_ps(zero, a[2], _CMP_GT_OQ)
+                                        : _mm256_cmp_ps(zero, _mm256_add_ps(a[2], a[3]), _CMP_GT_OQ));
+    bits[5] = _mm256_movemask_ps(_mm256_cmp_ps(a[2], a[3], _CMP_GT_OQ));
+}
+
+// shader_viewport: one division, then ndc * scale + translate as one fma.
+void viewport8(const __m256* a, const float scale[3], const float translate[3], float win[3][8]) {
+    const __m256 oow = _mm256_div_ps(_mm256_set1_ps(1.0f), a[3]);
+    for (int c = 0; c < 3; ++c) {
+        const __m256 ndc = _mm256_mul_ps(a[c], oow);
+        _mm256_storeu_ps(win[c], _mm256_fmadd_ps(ndc, _mm256_set1_ps(scale[c]), _mm256_set1_ps(translate[c])));
+    }
+}
+
+}  // namespace
+
+bool viewport_lanes8_avx2(SetupLanes8& io, const float* const corners[24], const float scale[3],
+                          const float translate[3], bool half_z) {
+    std::uint32_t clipped = 0;
+    for (int k = 0; k < 3; ++k) {  // corner slot k of the 8 triangles
+        __m128 r[8];
+        for (int t = 0; t < 8; ++t) r[t] = _mm_loadu_ps(corners[3 * t + k]);
+        __m256 a[4];
+        transpose8x4(r, a);
+        int bits[6];
+        clip_bits8(a, half_z, bits);
+        clipped |= static_cast<std::uint32_t>(bits[0] | bits[1] | bits[2] | bits[3] | bits[4] | bits[5]);
+        viewport8(a, scale, translate, io.win[k]);
+    }
+    io.clipped = clipped;
+    return true;
+}
+
+bool vertices8_avx2(const float* vertices, const float scale[3], const float translate[3], bool half_z,
+                    float win[3][8], std::uint32_t mask[8]) {
+    __m128 r[8];
+    for (int t = 0; t < 8; ++t) r[t] = _mm_loadu_ps(vertices + 4 * t);
+    __m256 a[4];
+    transpose8x4(r, a);
+    int bits[6];
+    clip_bits8(a, half_z, bits);
+    for (int t = 0; t < 8; ++t) {
+        std::uint32_t m = 0;
+        for (int b = 0; b < 6; ++b) m |= static_cast<std::uint32_t>((bits[b] >> t) & 1) << b;
+        mask[t] = m;
+    }
+    viewport8(a, scale, translate, win);
+    return true;
+}
+
+#else
+
+bool setup_lanes8_avx2(SetupLanes8&, bool) { return false; }
+bool viewport_lanes8_avx2(SetupLanes8&, const float* const[24], const float[3], const float[3], bool) { return false; }
+bool vertices8_avx2(const float*, const float[3], const float[3], bool, float[3][8], std::uint32_t[8]) { return false; }
+
+#endif
+
+}  // namespace raster::detail
