@@ -159,6 +159,21 @@ double offset_radius(const OrthoView& view) {
 
 namespace {
 
+// Axis k of a triangle box's clip bounds before their outward rounding: l, h, and the margins ml,
+// mh that push them out (see write_triangle_boxes). The margins' product by 2^-49 is exact, so a
+// compiler that fuses it into the subtraction rounds the same.
+struct AxisBounds {
+    double l, h, ml, mh;
+};
+AxisBounds axis_bounds(const Frame& f, double r, const Double3& lo, const Double3& hi, int k) {
+    const double scale = comp(f.scale, k);
+    const double l = (comp(lo, k) - r - comp(f.lo, k)) * scale - 1.0;
+    const double h = (comp(hi, k) + r - comp(f.lo, k)) * scale - 1.0;
+    const double big_l = (std::fabs(comp(lo, k)) + r + std::fabs(comp(f.lo, k))) * scale;
+    const double big_h = (std::fabs(comp(hi, k)) + r + std::fabs(comp(f.lo, k))) * scale;
+    return {l, h, (big_l + std::fabs(l) + 1.0) * 0x1p-49, (big_h + std::fabs(h) + 1.0) * 0x1p-49};
+}
+
 // Boxes [first, last) of (a) (= triangles), on validated input: their overshoot, and with Store
 // the boxes into `out`.
 template <bool Store>
@@ -193,27 +208,17 @@ Result<double> write_triangle_boxes(const OrthoView& view, std::span<const Doubl
             // result nor the error.
             bool nan = false, inside = false;
             for (int k = 0; k < 3; ++k) {
-                const double scale = comp(f.scale, k);
-                const double l = (comp(lo, k) - r - comp(f.lo, k)) * scale - 1.0;
-                const double h = (comp(hi, k) + r - comp(f.lo, k)) * scale - 1.0;
-                const double big_l = (std::fabs(comp(lo, k)) + r + std::fabs(comp(f.lo, k))) * scale;
-                const double big_h = (std::fabs(comp(hi, k)) + r + std::fabs(comp(f.lo, k))) * scale;
-                const double ml = (big_l + std::fabs(l) + 1.0) * 0x1p-49;
-                const double mh = (big_h + std::fabs(h) + 1.0) * 0x1p-49;
-                nan = nan || std::isnan(l - ml) || std::isnan(h + mh);
-                inside = ml >= 0.0 && mh >= 0.0 && l <= 1.0 && h >= -1.0;  // kept for k = 2, the depth
+                const AxisBounds b = axis_bounds(f, r, lo, hi, k);
+                nan = nan || std::isnan(b.l - b.ml) || std::isnan(b.h + b.mh);
+                inside = b.ml >= 0.0 && b.mh >= 0.0 && b.l <= 1.0 && b.h >= -1.0;  // kept for k = 2, the depth
             }
             if (!nan && inside) continue;
         }
         float cmin[3], cmax[3];
         for (int k = 0; k < 3; ++k) {
-            const double scale = comp(f.scale, k);
-            const double l = (comp(lo, k) - r - comp(f.lo, k)) * scale - 1.0;
-            const double h = (comp(hi, k) + r - comp(f.lo, k)) * scale - 1.0;
-            const double big_l = (std::fabs(comp(lo, k)) + r + std::fabs(comp(f.lo, k))) * scale;
-            const double big_h = (std::fabs(comp(hi, k)) + r + std::fabs(comp(f.lo, k))) * scale;
-            cmin[k] = round_down(l - (big_l + std::fabs(l) + 1.0) * 0x1p-49);
-            cmax[k] = round_up(h + (big_h + std::fabs(h) + 1.0) * 0x1p-49);
+            const AxisBounds b = axis_bounds(f, r, lo, hi, k);
+            cmin[k] = round_down(b.l - b.ml);
+            cmax[k] = round_up(b.h + b.mh);
             if (!std::isfinite(cmin[k]) || !std::isfinite(cmax[k]))
                 return Error{"triangle_offset_boxes: triangle " + std::to_string(t / 3) +
                              ": its box overflows float in clip space"};

@@ -398,39 +398,31 @@ TEST_CASE("Offset boxes in parts are the whole call's, bit for bit; the overshoo
 TEST_CASE("Offset boxes in parts check their output and range, and validate their own triangles only") {
     auto v = raster::make_ortho_view(raster::Axis::Z, {0, 0, 0}, {1, 1, 1}, 8, 8, raster::DepthFormat::D24);
     REQUIRE(v.ok());
+    const raster::OrthoView& view = v.value();
     const std::vector<Double3> pts = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, std::nan(""), 0}};
     const std::vector<std::uint32_t> idx = {0, 1, 2, 0, 1, 3, 0, 1, 9};
+    // Whether the call failed with a message containing `what`.
+    const auto fails_with = [](const raster::Result<double>& r, const std::string& what) {
+        CAPTURE(r.ok() ? std::string("(ok)") : r.error().message);
+        return !r.ok() && r.error().message.find(what) != std::string::npos;
+    };
     raster::OffsetMesh out;
-    auto r = raster::triangle_offset_boxes_part(v.value(), pts, idx, 0, 1, out);
-    REQUIRE_FALSE(r.ok());
-    CHECK(r.error().message.find("not those of 3 boxes (size_offset_boxes)") != std::string::npos);
+    CHECK(fails_with(raster::triangle_offset_boxes_part(view, pts, idx, 0, 1, out),
+                     "not those of 3 boxes (size_offset_boxes)"));
     raster::size_offset_boxes(3, out);
-    r = raster::triangle_offset_boxes_part(v.value(), pts, idx, 2, 4, out);
-    REQUIRE_FALSE(r.ok());
-    CHECK(r.error().message.find("boxes [2, 4) are not a range of the 3 boxes") != std::string::npos);
-    r = raster::triangle_offset_boxes_overshoot(v.value(), pts, idx, 1, 0);
-    REQUIRE_FALSE(r.ok());
-    CHECK(r.error().message.find("boxes [1, 0) are not a range") != std::string::npos);
+    CHECK(fails_with(raster::triangle_offset_boxes_part(view, pts, idx, 2, 4, out),
+                     "boxes [2, 4) are not a range of the 3 boxes"));
+    CHECK(fails_with(raster::triangle_offset_boxes_overshoot(view, pts, idx, 1, 0), "boxes [1, 0) are not a range"));
     // Triangle 0 is fine, 1 has a NaN vertex, 2 an index beyond the list: each part names its own.
-    r = raster::triangle_offset_boxes_part(v.value(), pts, idx, 0, 1, out);
-    CHECK(r.ok());
-    r = raster::triangle_offset_boxes_part(v.value(), pts, idx, 1, 3, out);
-    REQUIRE_FALSE(r.ok());
-    CHECK(r.error().message.find("triangle 1: vertex 3 is not finite") != std::string::npos);
-    r = raster::triangle_offset_boxes_overshoot(v.value(), pts, idx, 2, 3);
-    REQUIRE_FALSE(r.ok());
-    CHECK(r.error().message.find("triangle 2: index 9 at position 8") != std::string::npos);
-    r = raster::object_offset_obbs_part(v.value(), pts, idx, 0, 1, out, 1);
-    CHECK(r.ok());
-    r = raster::object_offset_obbs_part(v.value(), pts, idx, 0, 1, out, 2);  // 2 boxes of 2, not 3
-    REQUIRE_FALSE(r.ok());
-    CHECK(r.error().message.find("not those of 2 boxes") != std::string::npos);
-    r = raster::object_offset_obbs_part(v.value(), pts, idx, 0, 1, out, 0);
-    REQUIRE_FALSE(r.ok());
-    CHECK(r.error().message.find("triangles_per_box must be >= 1") != std::string::npos);
-    r = raster::triangle_offset_boxes_overshoot(v.value(), pts, std::vector<std::uint32_t>{0, 1}, 0, 0);
-    REQUIRE_FALSE(r.ok());
-    CHECK(r.error().message.find("multiple of 3") != std::string::npos);
+    CHECK(raster::triangle_offset_boxes_part(view, pts, idx, 0, 1, out).ok());
+    CHECK(fails_with(raster::triangle_offset_boxes_part(view, pts, idx, 1, 3, out), "triangle 1: vertex 3 is not finite"));
+    CHECK(fails_with(raster::triangle_offset_boxes_overshoot(view, pts, idx, 2, 3), "triangle 2: index 9 at position 8"));
+    CHECK(raster::object_offset_obbs_part(view, pts, idx, 0, 1, out, 1).ok());
+    // With 2 triangles per box the list has 2 boxes, not the 3 `out` holds.
+    CHECK(fails_with(raster::object_offset_obbs_part(view, pts, idx, 0, 1, out, 2), "not those of 2 boxes"));
+    CHECK(fails_with(raster::object_offset_obbs_part(view, pts, idx, 0, 1, out, 0), "triangles_per_box must be >= 1"));
+    CHECK(fails_with(raster::triangle_offset_boxes_overshoot(view, pts, std::vector<std::uint32_t>{0, 1}, 0, 0),
+                     "multiple of 3"));
 }
 
 TEST_CASE("Offset geometry and view helpers reject bad input naming what is wrong") {
