@@ -598,7 +598,7 @@ TEST_CASE("auto: the plan counts the exact stage's task triangles from the objec
     CHECK(cullide::plan_auto(two, one).object_pairs == 0);
 }
 
-TEST_CASE("auto: straight to the exact stage on small or loose scenes, views on a heap; always the ground truth") {
+TEST_CASE("auto: straight to the exact stage on small or loose scenes, views on a heap: always the ground truth") {
     // Small: two crossing triangles take the exact path (no view).
     const std::vector<cullide::Mesh> tiny = {
         triangle({0, 0, 0}, 1, {1, 0.1, 0.3}, {-0.5, 0.87, -0.2}, {-0.5, -0.87, 0.1}, "t1"),

@@ -90,7 +90,7 @@ class CaptureDevice final : public cullide::QueryDevice {
 
 }  // namespace
 
-TEST_CASE("llvmpipe over-counts a query of a long batch; a glFlush every 64 queries restores the exact answers") {
+TEST_CASE("llvmpipe over-counts a query of a long batch: a glFlush every 64 queries restores the exact answers") {
     // Before the first OSMesa context of this process: llvmpipe reads it when it makes its screen.
     REQUIRE(setenv("LP_NUM_THREADS", "0", 1) == 0);
     cullide::SceneOptions so;

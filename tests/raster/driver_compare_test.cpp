@@ -8,7 +8,7 @@
 
 #include "driver_compare.h"
 
-TEST_CASE("Equal results are identical; every kind of difference is counted where it belongs") {
+TEST_CASE("Equal results are identical: every kind of difference is counted where it belongs") {
     raster_test::DriverRow row;
     row.width = 4;
     const std::vector<std::uint64_t> q = {0, 5, 1, 7};

@@ -322,7 +322,7 @@ double scan_overshoot(const raster::OffsetMesh& m, std::size_t first, std::size_
 
 bool same_bits(const raster::Float4& a, const raster::Float4& b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
-TEST_CASE("Offset boxes in parts are the whole call's, bit for bit; the overshoot alone is a part's") {
+TEST_CASE("Offset boxes in parts are the whole call's, bit for bit: the overshoot alone is a part's") {
     test::Rng rng(31);
     int beyond = 0, fitting = 0;  // ranges whose overshoot is positive / zero (both must be met)
     for (int rep = 0; rep < 200; ++rep) {

@@ -229,7 +229,7 @@ TEST_CASE(
     }
 }
 
-TEST_CASE("Perspective error: far objects shrink below a pixel; orthographic reliable views catch them") {
+TEST_CASE("Perspective error: far objects shrink below a pixel: orthographic reliable views catch them") {
     // Two tiny squares 0.04 wide, B 0.01 behind A, 100 units in front of a 60-degree perspective
     // camera on a 16 x 16 target: about 7 world units per pixel, and the squares sit between
     // centres. CULLIDE's orthographic view fitted to the objects' box does not shrink them.

@@ -442,7 +442,7 @@ TEST_CASE("Depth functions compare incoming with stored, and the write mask is h
     }
 }
 
-TEST_CASE("Triangles behind the eye or beyond the far plane draw nothing; crossing ones are clipped") {
+TEST_CASE("Triangles behind the eye or beyond the far plane draw nothing: crossing ones are clipped") {
     const int W = 32, H = 32;
     auto t = raster::DepthTarget::create(W, H, DepthFormat::D32F).value();
     const std::vector<Float4> behind = {{-1, -1, -2, -1}, {1, -1, -2, -1}, {0, 1, -2, -1}};  // w < 0
