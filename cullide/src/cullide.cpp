@@ -121,17 +121,16 @@ using detail::unite;
 // left the second thread idle where one object holds most of the triangles (the tree of leaves: 7 ms
 // per sub-object view on one thread, whatever the PCS).
 constexpr std::size_t kOffsetPartTriangles = 4096;
-constexpr std::uint32_t kObbTriangles = 16;  // raster::object_offset_obbs' default group
 
 // How many offset solids (boxes) object `og` has at `stage`.
 std::size_t offset_boxes(const ObjectGeometry& og, CullStage stage) {
     const std::size_t tris = og.indices.size() / 3;
     if (stage == CullStage::Boxes) return 1;
-    if (stage == CullStage::Objects) return (tris + kObbTriangles - 1) / kObbTriangles;
+    if (stage == CullStage::Objects) return (tris + raster::kObbTrianglesPerBox - 1) / raster::kObbTrianglesPerBox;
     return tris;
 }
 std::size_t offset_part_boxes(CullStage stage) {
-    return stage == CullStage::Objects ? kOffsetPartTriangles / kObbTriangles : kOffsetPartTriangles;
+    return stage == CullStage::Objects ? kOffsetPartTriangles / raster::kObbTrianglesPerBox : kOffsetPartTriangles;
 }
 
 // This view's offset solids [first, last) of one object (see ObjectGeometry), written into its
@@ -141,7 +140,7 @@ raster::Result<double> prepare_offset_part(ObjectGeometry& og, CullStage stage, 
     // The box of the degenerate triangle (lo, hi, lo) is the object's box.
     static constexpr std::array<std::uint32_t, 3> kBoxCorners{0, 7, 0};
     return stage == CullStage::Objects ? raster::object_offset_obbs_part(view, og.positions, og.indices, first, last,
-                                                                         og.offset, kObbTriangles)
+                                                                         og.offset, raster::kObbTrianglesPerBox)
            : stage == CullStage::Boxes ? raster::triangle_offset_boxes_part(view, og.positions, kBoxCorners, first,
                                                                             last, og.offset)
                                        : raster::triangle_offset_boxes_part(view, og.positions, og.indices, first, last,

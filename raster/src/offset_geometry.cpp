@@ -99,6 +99,14 @@ Status validate_mesh(std::span<const Double3> vertices, std::span<const std::uin
     return validate_range(vertices, indices, 0, indices.size(), what);
 }
 
+// A part call's check of its box range.
+Status check_range(std::size_t total_boxes, std::size_t first_box, std::size_t last_box, const char* what) {
+    if (first_box > last_box || last_box > total_boxes)
+        return Error{std::string(what) + ": boxes [" + std::to_string(first_box) + ", " + std::to_string(last_box) +
+                     ") are not a range of the " + std::to_string(total_boxes) + " boxes"};
+    return {};
+}
+
 // A part call's checks of `out` and its box range.
 Status check_part(const OffsetMesh& out, std::size_t total_boxes, std::size_t first_box, std::size_t last_box,
                   const char* what) {
@@ -106,10 +114,12 @@ Status check_part(const OffsetMesh& out, std::size_t total_boxes, std::size_t fi
         return Error{std::string(what) + ": the output holds " + std::to_string(out.vertices.size()) + " vertices and " +
                      std::to_string(out.indices.size()) + " indices, not those of " + std::to_string(total_boxes) +
                      " boxes (size_offset_boxes)"};
-    if (first_box > last_box || last_box > total_boxes)
-        return Error{std::string(what) + ": boxes [" + std::to_string(first_box) + ", " + std::to_string(last_box) +
-                     ") are not a range of the " + std::to_string(total_boxes) + " boxes"};
-    return {};
+    return check_range(total_boxes, first_box, last_box, what);
+}
+
+// How far a clip depth lies beyond [-1, 1] (0 inside).
+double depth_overshoot(float z) {
+    return std::max({0.0, static_cast<double>(z) - 1.0, -1.0 - static_cast<double>(z)});
 }
 
 // Box b's corners and indices into their places in `out` (sized for every box); returns the
@@ -120,8 +130,7 @@ double store_box(OffsetMesh& out, std::size_t b, const std::array<Float4, 8>& co
     std::uint32_t* idx = out.indices.data() + 36 * b;
     for (std::size_t k = 0; k < 36; ++k) idx[k] = base + kBox[k];
     double overshoot = 0.0;
-    for (const Float4& v : corners)
-        overshoot = std::max({overshoot, static_cast<double>(v.z) - 1.0, -1.0 - static_cast<double>(v.z)});
+    for (const Float4& v : corners) overshoot = std::max(overshoot, depth_overshoot(v.z));
     return overshoot;
 }
 
@@ -225,8 +234,7 @@ Result<double> write_triangle_boxes(const OrthoView& view, std::span<const Doubl
         }
         clamp_box(cmin, cmax);
         if constexpr (!Store) {  // store_box's overshoot: the corners' depths are cmin[2] and cmax[2]
-            overshoot = std::max({overshoot, static_cast<double>(cmax[2]) - 1.0, -1.0 - static_cast<double>(cmin[2]),
-                                  static_cast<double>(cmin[2]) - 1.0, -1.0 - static_cast<double>(cmax[2])});
+            overshoot = std::max({overshoot, depth_overshoot(cmin[2]), depth_overshoot(cmax[2])});
             continue;
         }
         std::array<Float4, 8> corners{};
@@ -265,9 +273,7 @@ Result<double> triangle_offset_boxes_overshoot(const OrthoView& view, std::span<
                                                std::size_t last_box) {
     constexpr const char* kWhat = "triangle_offset_boxes";
     if (Status s = check_count(indices, kWhat); !s) return s.error();
-    if (first_box > last_box || last_box > indices.size() / 3)
-        return Error{std::string(kWhat) + ": boxes [" + std::to_string(first_box) + ", " + std::to_string(last_box) +
-                     ") are not a range of the " + std::to_string(indices.size() / 3) + " boxes"};
+    if (Status s = check_range(indices.size() / 3, first_box, last_box, kWhat); !s) return s.error();
     if (Status s = validate_range(vertices, indices, 3 * first_box, 3 * last_box, kWhat); !s) return s.error();
     return write_triangle_boxes<false>(view, vertices, indices, first_box, last_box, nullptr);
 }

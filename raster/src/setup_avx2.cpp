@@ -56,7 +56,7 @@ Plane8 plane8(const __m256* v0, const __m256* v1, const __m256* v2) {
 
 }  // namespace
 
-bool setup_lanes8_avx2(SetupLanes8& io, bool provoking_first) {
+void setup_lanes8_avx2(SetupLanes8& io, bool provoking_first) {
     __m256 v[3][3];
     for (int k = 0; k < 3; ++k)
         for (int c = 0; c < 3; ++c) v[k][c] = _mm256_loadu_ps(io.win[k][c]);
@@ -84,7 +84,6 @@ bool setup_lanes8_avx2(SetupLanes8& io, bool provoking_first) {
     _mm256_storeu_ps(io.z0[1], swapped.z0);
     _mm256_storeu_ps(io.dzdx[1], swapped.dzdx);
     _mm256_storeu_ps(io.dzdy[1], swapped.dzdy);
-    return true;
 }
 
 namespace {
@@ -129,7 +128,7 @@ void viewport8(const __m256* a, const float scale[3], const float translate[3], 
 
 }  // namespace
 
-bool viewport_lanes8_avx2(SetupLanes8& io, const float* const corners[24], const float scale[3],
+void viewport_lanes8_avx2(SetupLanes8& io, const float* const corners[24], const float scale[3],
                           const float translate[3], bool half_z) {
     std::uint32_t clipped = 0;
     for (int k = 0; k < 3; ++k) {  // corner slot k of the 8 triangles
@@ -143,10 +142,9 @@ bool viewport_lanes8_avx2(SetupLanes8& io, const float* const corners[24], const
         viewport8(a, scale, translate, io.win[k]);
     }
     io.clipped = clipped;
-    return true;
 }
 
-bool vertices8_avx2(const float* vertices, const float scale[3], const float translate[3], bool half_z,
+void vertices8_avx2(const float* vertices, const float scale[3], const float translate[3], bool half_z,
                     float win[3][8], std::uint32_t mask[8]) {
     __m128 r[8];
     for (int t = 0; t < 8; ++t) r[t] = _mm_loadu_ps(vertices + 4 * t);
@@ -160,14 +158,13 @@ bool vertices8_avx2(const float* vertices, const float scale[3], const float tra
         mask[t] = m;
     }
     viewport8(a, scale, translate, win);
-    return true;
 }
 
 #else
 
-bool setup_lanes8_avx2(SetupLanes8&, bool) { return false; }
-bool viewport_lanes8_avx2(SetupLanes8&, const float* const[24], const float[3], const float[3], bool) { return false; }
-bool vertices8_avx2(const float*, const float[3], const float[3], bool, float[3][8], std::uint32_t[8]) { return false; }
+void setup_lanes8_avx2(SetupLanes8&, bool) {}
+void viewport_lanes8_avx2(SetupLanes8&, const float* const[24], const float[3], const float[3], bool) {}
+void vertices8_avx2(const float*, const float[3], const float[3], bool, float[3][8], std::uint32_t[8]) {}
 
 #endif
 

@@ -22,18 +22,17 @@ struct SetupLanes8 {
     float z0[2][8], dzdx[2][8], dzdy[2][8];
 };
 
-// Fills in_range, sx, sy, z0, dzdx and dzdy from win. False (nothing written) when this build has
-// no AVX2 code.
-bool setup_lanes8_avx2(SetupLanes8& io, bool provoking_first);
+// Fills in_range, sx, sy, z0, dzdx and dzdy from win. Call only where kernel_avx2_available():
+// a build without AVX2 code has empty stubs.
+void setup_lanes8_avx2(SetupLanes8& io, bool provoking_first);
 // The clip test and the viewport of 8 triangles' corners: corners[3 t + k] is corner k of
-// triangle t (x, y, z, w). Fills win and clipped. False when this build has no AVX2 code.
-bool viewport_lanes8_avx2(SetupLanes8& io, const float* const corners[24], const float scale[3],
+// triangle t (x, y, z, w). Fills win and clipped (the same condition as setup_lanes8_avx2).
+void viewport_lanes8_avx2(SetupLanes8& io, const float* const corners[24], const float scale[3],
                           const float translate[3], bool half_z);
 
 // The clip test and the viewport of 8 consecutive vertices (x, y, z, w each): clip_mask's six
-// bits per vertex into mask, the window position into win[c][vertex]. False when this build has no
-// AVX2 code.
-bool vertices8_avx2(const float* vertices, const float scale[3], const float translate[3], bool half_z,
+// bits per vertex into mask, the window position into win[c][vertex] (the same condition).
+void vertices8_avx2(const float* vertices, const float scale[3], const float translate[3], bool half_z,
                     float win[3][8], std::uint32_t mask[8]);
 
 }  // namespace raster::detail

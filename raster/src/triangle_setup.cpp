@@ -285,13 +285,6 @@ void setup_lane(const FrontEndParams& p, const SetupLanes8& lanes, int t, std::u
         draw, out);
 }
 
-// Whether setup runs its float part 8 triangles at a time (setup_avx2.cpp): the AVX2 kernel's
-// condition, read once.
-bool simd_setup() {
-    static const bool on = kernel_avx2_available() && simd_allowed_by_environment();
-    return on;
-}
-
 // The rest of setup_triangle_for, from vertices already through the clip test (masks m0..m2) and the
 // viewport: whole-triangle rejection, then setup, or clipping and the setup of the fan.
 template <RasterRules Rules>
@@ -392,7 +385,7 @@ void setup_range_for(const FrontEndParams& params, std::span<const Float4> verti
     static_assert(kFusedViewport, "setup_avx2.cpp's viewport is the fused one");
     static_assert(sizeof(Float4) == 4 * sizeof(float), "corners are read as 4 floats");
     const std::size_t n = indices.size() / 3 * 3;
-    const bool simd = simd_setup();
+    const bool simd = simd_kernel_active();  // setup's float part 8 triangles at a time (setup_avx2.cpp)
     const ViewportXform xf = make_xform(rules, params.viewport);
     if (n < vertices.size()) {  // a few triangles of a large list (a sub-object's draw): per corner
         std::size_t k = 0;

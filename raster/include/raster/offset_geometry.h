@@ -51,9 +51,10 @@ struct OffsetMesh {
 // `triangles_per_box` (index order), each group bounded by an oriented box grown by
 // offset_radius(view). The box's frame is the least-volume one of: the view axes, and the group's
 // largest triangle's normal with each of its edges. Same validation as (a); triangles_per_box >= 1.
+inline constexpr std::uint32_t kObbTrianglesPerBox = 16;  // (b)'s default group
 [[nodiscard]] Result<OffsetMesh> object_offset_obbs(const OrthoView& view, std::span<const Double3> vertices,
                                                     std::span<const std::uint32_t> indices,
-                                                    std::uint32_t triangles_per_box = 16);
+                                                    std::uint32_t triangles_per_box = kObbTrianglesPerBox);
 
 // Parts of (a) and (b), written in place, for callers that prepare one large object per view on
 // several threads and keep the memory between views. `out` must already hold every box of the whole
@@ -72,7 +73,7 @@ struct OffsetMesh {
 [[nodiscard]] Result<double> object_offset_obbs_part(const OrthoView& view, std::span<const Double3> vertices,
                                                      std::span<const std::uint32_t> indices, std::size_t first_box,
                                                      std::size_t last_box, OffsetMesh& out,
-                                                     std::uint32_t triangles_per_box = 16);
+                                                     std::uint32_t triangles_per_box = kObbTrianglesPerBox);
 // What triangle_offset_boxes_part would return for the same boxes (their overshoot, or the same
 // failure), without writing them: for a caller that draws only some of a view's boxes but fits the
 // view to all of them.
