@@ -19,24 +19,6 @@ constexpr double pow2m(int k) {
     return r;
 }
 
-// Margins (docs/reliable-raster.md): each is at least 2^8 times the rounding error it covers.
-constexpr double kClipMarginRel = pow2m(40);  // clip units per unit of the triangle's magnitude M
-constexpr double kPixelMargin = pow2m(20);    // pixels, for the window-space steps (|X| < 2^16)
-constexpr double kDepthMargin = pow2m(40);    // window depth, for the window-space steps
-
-// floor and ceil without a libm call on baseline x86-64 (equal to std::floor / std::ceil for every
-// finite x, up to the sign of a zero result: |x| >= 2^52 is already an integer).
-double exact_floor(double x) {
-    if (!(std::fabs(x) < 0x1p52)) return x;
-    const double t = static_cast<double>(static_cast<std::int64_t>(x));
-    return t > x ? t - 1.0 : t;
-}
-double exact_ceil(double x) {
-    if (!(std::fabs(x) < 0x1p52)) return x;
-    const double t = static_cast<double>(static_cast<std::int64_t>(x));
-    return t < x ? t + 1.0 : t;
-}
-
 }  // namespace
 
 namespace {

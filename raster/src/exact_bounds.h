@@ -28,6 +28,24 @@ namespace raster::detail {
 
 inline constexpr int kBoundsMaxVerts = 16;  // 3 + 6 clip planes + 4 square planes, rounded up
 
+// Margins (docs/reliable-raster.md): each is at least 2^8 times the rounding error it covers.
+inline constexpr double kClipMarginRel = 0x1p-40;  // clip units per unit of the triangle's magnitude M
+inline constexpr double kPixelMargin = 0x1p-20;    // pixels, for the window-space steps (|X| < 2^16)
+inline constexpr double kDepthMargin = 0x1p-40;    // window depth, for the window-space steps
+
+// floor and ceil without a libm call on baseline x86-64 (equal to std::floor / std::ceil for every
+// finite x, up to the sign of a zero result: |x| >= 2^52 is already an integer).
+inline double exact_floor(double x) {
+    if (!(std::fabs(x) < 0x1p52)) return x;
+    const double t = static_cast<double>(static_cast<std::int64_t>(x));
+    return t > x ? t - 1.0 : t;
+}
+inline double exact_ceil(double x) {
+    if (!(std::fabs(x) < 0x1p52)) return x;
+    const double t = static_cast<double>(static_cast<std::int64_t>(x));
+    return t < x ? t + 1.0 : t;
+}
+
 // One vertex of a clipped polygon in window coordinates.
 struct BoundsVertex {
     double x, y, z;
@@ -141,6 +159,122 @@ inline std::uint32_t quantize_up(double z, DepthFormat format) {
     if (std::fma(z, n, -(v - 1.0)) <= 0.0) v -= 1.0;
     v = std::clamp(v, 0.0, n);
     return static_cast<std::uint32_t>(v);
+}
+
+// Where a list of triangles can reach, from its vertices alone (no setup, no clipping): for a
+// pre-pass that decides which triangles need setting up at all (the fused visibility pass's items
+// alone in the view). bounds_reach calls box(x0, y0, x1, y1) (inclusive pixels inside the target)
+// for boxes whose union holds the pixel box of every BoundsTri that setup_bounds_triangle makes of
+// the triangles: their common box, or one box per triangle when the common one would be more than
+// kReachSpread times the triangles' count in cells of 2^shift pixels (scattered triangles). It
+// returns whether it made one box (`single`) and an encoded depth at least every zmax of their
+// fragments (quantize_up(zhi + margin_z) as bounds_depth_range bounds zhi). ok = false when an index
+// or vertex fails the input checks (nothing is marked; the front end reports it).
+struct BoundsReach {
+    int x0 = 0, y0 = 0, x1 = -1, y1 = -1;  // the one box, when single and not empty
+    std::uint32_t zq_hi = 0xffffffffu;
+    bool ok = true;
+    bool single = true;  // one box (or none: nothing reaches the target)
+    bool empty = true;   // no box at all
+};
+inline constexpr int kReachSpread = 4;
+inline constexpr int kReachMaxIndices = 96;  // per-triangle boxes for lists up to this many indices
+
+template <class Box>
+BoundsReach bounds_reach(const FrontEndParams& params, const MeshViewD& mesh, DepthFormat format, int shift,
+                         Box&& box) {
+    BoundsReach r;
+    const std::size_t nv = mesh.vertices.size();
+    const std::size_t n = mesh.indices.size() - mesh.indices.size() % 3;
+    if (n == 0) return r;
+    constexpr double kInf = __builtin_inf();
+    double absmax = 0.0, cx0 = kInf, cx1 = -kInf, cy0 = kInf, cy1 = -kInf, cz0 = kInf, cz1 = -kInf;
+    for (std::size_t k = 0; k < n; ++k) {
+        const std::uint32_t i = mesh.indices[k];
+        if (i >= nv) return BoundsReach{0, 0, -1, -1, 0xffffffffu, false, true, true};
+        const Double4& v = mesh.vertices[i];
+        const double m = std::max(std::max(std::fabs(v.x), std::fabs(v.y)), std::fabs(v.z));
+        if (v.w != 1.0 || !(m <= kMaxExactBoundsCoordinate)) return BoundsReach{0, 0, -1, -1, 0xffffffffu, false, true, true};
+        absmax = m > absmax ? m : absmax;
+        cx0 = std::min(cx0, v.x), cx1 = std::max(cx1, v.x);
+        cy0 = std::min(cy0, v.y), cy1 = std::max(cy1, v.y);
+        cz0 = std::min(cz0, v.z), cz1 = std::max(cz1, v.z);
+    }
+    // A triangle's clip keeps nothing when all its vertices are beyond one plane of the volume
+    // grown to lim = 1 + M 2^-40 (lim - v < 0 for each: the sign of the rounded difference is the
+    // exact one); M <= max(1, absmax), so lim <= the item's `lim` (the same rounded sum).
+    const double mc = std::max(1.0, absmax) * kClipMarginRel;
+    const double lim = 1.0 + mc;
+    if (cx0 > lim || cx1 < -lim || cy0 > lim || cy1 < -lim || cz0 > lim || cz1 < -lim) return r;
+    const Viewport& vp = params.viewport;
+    const double hw = static_cast<double>(vp.width) * 0.5;
+    const double hh = static_cast<double>(vp.height) * 0.5;
+    const double tx = static_cast<double>(vp.x) + hw;
+    const double ty = static_cast<double>(vp.y) + hh;
+    const double w1 = static_cast<double>(params.target_width - 1), h1 = static_cast<double>(params.target_height - 1);
+    r.empty = false;
+    if (absmax > 2.0) {  // large magnitudes: clipping's rounding scales with M; the whole target
+        box(0, 0, params.target_width - 1, params.target_height - 1);
+        return r;
+    }
+    // Every triangle's margins are at most m and mz (its M <= max(1, absmax)). With |v| <= 1 < lim
+    // setup_bounds_triangle takes each triangle unclipped with window coordinates v * (w / 2) + (x0 +
+    // w / 2) and depth z * 0.5 + 0.5: the same operations below give the same values, and rounding
+    // is monotone, so ceil(min X - m) - 1 over more vertices and a larger margin is at most each
+    // triangle's, and so on. With 1 < |v| <= 2 a triangle may be clipped: its polygon lies in its
+    // hull cut to [-lim, lim] up to clipping's rounding (< 2^-43 clip units, < 2^-30 pixels and
+    // 2^-44 in depth at every target size), far inside the extra pixel and 2^-30 added then.
+    const bool clipped = absmax > 1.0;
+    const double extra = clipped ? 1.0 : 0.0;
+    const double m = kPixelMargin + mc * std::max(hw, hh) + extra;
+    const auto clamp_c = [&](double c) { return clipped ? std::clamp(c, -lim, lim) : c; };
+    // The depth bound: every zhi is at most the largest vertex depth (bounds_depth_range), widened
+    // for the general path by 2^-40 max|z| + 2^-1000; then the margin, then the outward quantization.
+    {
+        const double z0 = clamp_c(cz0) * 0.5 + 0.5, z1 = clamp_c(cz1) * 0.5 + 0.5;
+        const double slack = 0x1p-40 * std::max(std::fabs(z0), std::fabs(z1)) + 0x1p-1000 + (clipped ? 0x1p-30 : 0.0);
+        r.zq_hi = quantize_up((z1 + slack) + (kDepthMargin + mc), format);
+    }
+    // The box of window extremes [x0, x1] x [y0, y1] grown by m, in the target; false when outside.
+    const auto pixel_box = [&](double x0, double x1, double y0, double y1, int* b) {
+        const double bx0 = exact_ceil(x0 - m) - 1.0, bx1 = exact_floor(x1 + m);
+        const double by0 = exact_ceil(y0 - m) - 1.0, by1 = exact_floor(y1 + m);
+        if (bx1 < 0.0 || by1 < 0.0 || bx0 > w1 || by0 > h1) return false;
+        b[0] = static_cast<int>(std::max(bx0, 0.0));
+        b[1] = static_cast<int>(std::max(by0, 0.0));
+        b[2] = static_cast<int>(std::min(bx1, w1));
+        b[3] = static_cast<int>(std::min(by1, h1));
+        return true;
+    };
+    int all[4];
+    if (!pixel_box(clamp_c(cx0) * hw + tx, clamp_c(cx1) * hw + tx, clamp_c(cy0) * hh + ty, clamp_c(cy1) * hh + ty,
+                   all)) {
+        r.empty = true;
+        return r;
+    }
+    const std::size_t cells = static_cast<std::size_t>((all[2] >> shift) - (all[0] >> shift) + 1) *
+                              static_cast<std::size_t>((all[3] >> shift) - (all[1] >> shift) + 1);
+    if (cells <= static_cast<std::size_t>(kReachSpread) * (n / 3) || n > static_cast<std::size_t>(kReachMaxIndices)) {
+        box(all[0], all[1], all[2], all[3]);
+        r.x0 = all[0], r.y0 = all[1], r.x1 = all[2], r.y1 = all[3];
+        return r;
+    }
+    r.single = false;
+    r.empty = true;
+    for (std::size_t k = 0; k < n; k += 3) {
+        const Double4& a = mesh.vertices[mesh.indices[k]];
+        const Double4& b = mesh.vertices[mesh.indices[k + 1]];
+        const Double4& c = mesh.vertices[mesh.indices[k + 2]];
+        const double xa = clamp_c(a.x) * hw + tx, xb = clamp_c(b.x) * hw + tx, xc = clamp_c(c.x) * hw + tx;
+        const double ya = clamp_c(a.y) * hh + ty, yb = clamp_c(b.y) * hh + ty, yc = clamp_c(c.y) * hh + ty;
+        int t[4];
+        if (pixel_box(std::min(std::min(xa, xb), xc), std::max(std::max(xa, xb), xc), std::min(std::min(ya, yb), yc),
+                      std::max(std::max(ya, yb), yc), t)) {
+            box(t[0], t[1], t[2], t[3]);
+            r.empty = false;
+        }
+    }
+    return r;
 }
 
 // ---- the per-pixel traversal shared by bounds_rect and the fused visibility pass ----

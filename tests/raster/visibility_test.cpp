@@ -203,6 +203,144 @@ TEST_CASE("The fused visibility pass with large triangles (tiles settled from de
     CHECK(hidden > 10);
 }
 
+TEST_CASE("The fused visibility pass: items alone in the view are skipped with the recorded answers") {
+    // visibility.cpp, State::alone: an item whose pixels no other object's triangle comes near is
+    // neither set up nor drawn; its answer is 0 unless a fragment may reach the clear value. Objects
+    // in separate places (a few overlapping), each item a small cluster; some items reach the far
+    // plane (their query passes against the clear value even alone), some leave the clip volume by
+    // up to 2x (clipped: the box from the vertices needs its extra pixel) or far beyond (the whole
+    // target), some lie wholly outside, some have their triangles scattered; 32^2 (one tile; split between threads), 37 x 23, and 300 x 200
+    // (cells of 4 pixels).
+    test::Rng rng(20261127);
+    const DepthFormat formats[] = {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F};
+    const int sizes[][2] = {{32, 32}, {37, 23}, {300, 200}};
+    int visible = 0, hidden = 0, far_alone = 0;
+    std::uint64_t spared_runs = 0;
+    for (int rep = 0; rep < 18; ++rep) {
+        Scene s;
+        const int objects = 4 + static_cast<int>(rng.below(40));
+        s.objects = static_cast<std::uint32_t>(objects);
+        for (int o = 0; o < objects; ++o) {
+            const Double4 centre{rng.uniform(-0.95, 0.95), rng.uniform(-0.95, 0.95), rng.uniform(-0.9, 0.9), 1.0};
+            const int items = 1 + static_cast<int>(rng.below(30));
+            for (int it = 0; it < items; ++it) {
+                std::vector<std::uint32_t> idx;
+                const int kind = static_cast<int>(rng.below(12));
+                const Double4 c{centre.x + rng.uniform(-0.08, 0.08), centre.y + rng.uniform(-0.08, 0.08),
+                                kind == 0 ? 1.0 - rng.uniform(0.0, 1e-9) : centre.z + rng.uniform(-0.05, 0.05), 1.0};
+                for (int t = 0; t < 4; ++t) {
+                    const auto base = static_cast<std::uint32_t>(s.vertices.size());
+                    // Scattered items (kind 4): each triangle elsewhere, so one box would be too big
+                    // and the pre-pass marks each triangle's own.
+                    const Double4 tc = kind == 4 ? Double4{centre.x + rng.uniform(-0.5, 0.5), centre.y + rng.uniform(-0.5, 0.5),
+                                                           c.z, 1.0}
+                                                 : c;
+                    for (int k = 0; k < 3; ++k) {
+                        Double4 v{tc.x + rng.uniform(-0.02, 0.02), tc.y + rng.uniform(-0.02, 0.02),
+                                  kind == 0 ? c.z : c.z + rng.uniform(-0.02, 0.02), 1.0};
+                        if (kind == 1 && k == 0) v.x = rng.coin() ? 1.6 : -1.9;  // clipped, |v| <= 2
+                        if (kind == 2 && k == 1) v.y = 3.5;                      // far beyond: whole target
+                        if (kind == 3) v.x += 2.5;                               // wholly outside
+                        s.vertices.push_back(v);
+                    }
+                    idx.insert(idx.end(), {base, base + 1, base + 2});
+                }
+                if (kind == 0) ++far_alone;
+                s.item_indices.push_back(std::move(idx));
+                s.item_object.push_back(static_cast<std::uint32_t>(o));
+            }
+        }
+        const DepthFormat f = formats[rep % 3];
+        const int w = sizes[(rep / 3) % 3][0], h = sizes[(rep / 3) % 3][1];
+        CAPTURE(rep);
+        const std::vector<std::uint8_t> want = recorded(s, w, h, f, 1, true);
+        for (const int threads : {1, 2, 3, 8}) {
+            CAPTURE(threads);
+            raster::VisibilityPass pass;  // fresh: the pre-pass runs on a first call
+            auto got = pass.run(w, h, f, items_of(s), threads);
+            REQUIRE_MESSAGE(got.ok(), got.error().message);
+            CHECK(got.value() == want);
+            if (pass.last_spared_triangles() > 0) ++spared_runs;
+        }
+        for (auto v : want) (v != 0 ? hidden : visible) += 1;
+    }
+    CHECK(visible > 100);
+    CHECK(hidden > 100);
+    CHECK(far_alone > 20);
+    CHECK(spared_runs == 18 * 4);  // every run found items alone
+}
+
+TEST_CASE("The fused visibility pass: items that touch only at a pixel border are not alone") {
+    // Exact bounds cover closed pixel squares, so two triangles meeting on the line between two
+    // pixel columns (window X = 16 at clip x = 0 on 32 pixels) share pixels 15 and 16. The far one
+    // (object 0) is not fully visible there; the pre-pass must see both reach those pixels (a box
+    // one margin too tight would leave it alone, with the answer 0).
+    for (const DepthFormat f : {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F}) {
+        for (const double gap : {0.0, 1.0 / 16.0}) {  // 1/16 of clip space: one pixel column apart
+            CAPTURE(gap);
+            // Small triangles (boxes of 2 x 2 pixels: one box per item in the pre-pass).
+            const std::vector<Double4> v = {{-0.05, -0.02, 0.5, 1},      {0.0, 0.0, 0.5, 1},
+                                            {-0.05, 0.02, 0.5, 1},       {gap, -0.02, -0.5, 1},
+                                            {gap + 0.05, 0.0, -0.5, 1}, {gap, 0.02, -0.5, 1}};
+            const std::vector<std::uint32_t> a = {0, 1, 2}, b = {3, 4, 5};
+            const std::vector<raster::VisibilityItem> items = {{raster::MeshViewD{v, a}, 0},
+                                                               {raster::MeshViewD{v, b}, 1}};
+            Scene s;
+            s.vertices = v;
+            s.item_indices = {a, b};
+            s.item_object = {0, 1};
+            s.objects = 2;
+            const std::vector<std::uint8_t> want = recorded(s, 32, 32, f, 1, true);
+            // Touching: the far triangle is hidden at the shared pixels; one pixel column apart,
+            // the two still share the closed squares' border column, again hidden.
+            CHECK(want[0] == 1);
+            for (const int threads : {1, 2}) {
+                raster::VisibilityPass pass;
+                auto r = pass.run(32, 32, f, items, threads);
+                REQUIRE(r.ok());
+                CHECK(r.value() == want);
+            }
+            // Moved two pixel columns further away, both are alone: the pre-pass spares both.
+            std::vector<Double4> apart = v;
+            for (int k = 3; k < 6; ++k) apart[static_cast<std::size_t>(k)].x += 4.0 / 32.0;
+            const std::vector<raster::VisibilityItem> items_apart = {{raster::MeshViewD{apart, a}, 0},
+                                                                     {raster::MeshViewD{apart, b}, 1}};
+            raster::VisibilityPass pass;
+            auto r = pass.run(32, 32, f, items_apart, 1);
+            REQUIRE(r.ok());
+            CHECK(r.value() == std::vector<std::uint8_t>{0, 0});
+            CHECK(pass.last_spared_triangles() == 2);
+        }
+    }
+}
+
+TEST_CASE("The fused visibility pass: an item of scattered triangles reaches each triangle's pixels") {
+    // Object 0: one item of two small triangles at opposite corners (one box would be most of the
+    // target, so the pre-pass marks each triangle's box); object 1: a small item under the second
+    // triangle and behind it (hidden), and one in the empty middle (alone, spared).
+    for (const DepthFormat f : {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F}) {
+        const std::vector<Double4> v = {{-0.9, -0.9, -0.5, 1}, {-0.85, -0.9, -0.5, 1}, {-0.9, -0.85, -0.5, 1},
+                                        {0.8, 0.8, -0.5, 1},   {0.85, 0.8, -0.5, 1},   {0.8, 0.85, -0.5, 1},
+                                        {0.81, 0.81, 0.5, 1},  {0.84, 0.81, 0.5, 1},   {0.81, 0.84, 0.5, 1},
+                                        {0.0, 0.0, 0.5, 1},    {0.03, 0.0, 0.5, 1},    {0.0, 0.03, 0.5, 1}};
+        const std::vector<std::uint32_t> a = {0, 1, 2, 3, 4, 5}, b = {6, 7, 8}, c = {9, 10, 11};
+        Scene s;
+        s.vertices = v;
+        s.item_indices = {a, b, c};
+        s.item_object = {0, 1, 1};
+        s.objects = 2;
+        const std::vector<std::uint8_t> want = recorded(s, 32, 32, f, 1, true);
+        CHECK(want == std::vector<std::uint8_t>{0, 1, 0});
+        for (const int threads : {1, 2}) {
+            raster::VisibilityPass pass;
+            auto r = pass.run(32, 32, f, items_of(s), threads);
+            REQUIRE(r.ok());
+            CHECK(r.value() == want);
+            CHECK(pass.last_spared_triangles() == 1);  // the middle one only
+        }
+    }
+}
+
 TEST_CASE("The fused visibility pass: an item exactly at another object's depth is not fully visible") {
     // Two objects, one flat triangle each at the same depth: GEQUAL passes on equal values, so
     // neither is fully visible; with the second moved back, the first (nearer) is, the second not.
