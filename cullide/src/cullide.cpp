@@ -470,13 +470,13 @@ std::vector<raster::Double3> to_double3(const Mesh& m) {
 }
 
 Result<ViewSize> check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
-                              const CullideOptions& o) {
+                              const CullideOptions& o, bool scene_checked) {
     if (!(o.min_prune < 1.0))  // NaN too
         return Error{"min_prune must be below 1 (negative: the mode's default; got " + std::to_string(o.min_prune) +
                      ")"};
     if (o.object_stage != ObjectStage::Auto && o.object_stage != ObjectStage::On && o.object_stage != ObjectStage::Off)
         return Error{"object_stage is not Auto, On or Off"};
-    return detail::check_visibility_inputs(objects, active, o, o.mode);
+    return detail::check_visibility_inputs(objects, active, o, o.mode, scene_checked);
 }
 
 // The triangles of the surviving sub-objects, paired across objects and tested exactly: each live
@@ -586,7 +586,14 @@ std::vector<ObjectGeometry> subobject_geometry(std::span<const Mesh> objects, st
 Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
                                                 const CullideOptions& options, QueryDevice& device,
                                                 CullideStats* stats) {
-    Result<ViewSize> checked = check_inputs(objects, active, options);
+    return detail::cullide_pairs(objects, active, options, device, stats, false);
+}
+
+Result<std::vector<TrianglePair>> detail::cullide_pairs(std::span<const Mesh> objects,
+                                                        std::span<const std::uint32_t> active,
+                                                        const CullideOptions& options, QueryDevice& device,
+                                                        CullideStats* stats, bool scene_checked) {
+    Result<ViewSize> checked = check_inputs(objects, active, options, scene_checked);
     if (!checked) return checked.error();
     const ViewSize size = checked.value();
     CullideStats st;
@@ -628,7 +635,7 @@ Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects, s
 namespace cullide::detail {
 
 Result<ViewSize> check_visibility_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
-                                         const VisibilityOptions& o, VisibilityMode mode) {
+                                         const VisibilityOptions& o, VisibilityMode mode, bool scene_checked) {
     Result<ViewSize> size = view_size(o.resolution, mode);
     if (!size) return size.error();
     if (o.subobject_triangles < 1)
@@ -643,8 +650,10 @@ Result<ViewSize> check_visibility_inputs(std::span<const Mesh> objects, std::spa
     // Each object's scan in its own parallel job (they were serial work on the calling thread of
     // every frame); the problems are then reported in the order of the serial checks, so the same
     // first one is named.
+    // (Skipped when the caller checked every object already: process_frame. The scans were 5-7% of
+    // a cloth / rcullide frame, perf, after the items-alone pre-pass.)
     std::vector<Status> mesh_ok(objects.size()), range_ok(active.size());
-    detail::parallel_chunks(o.threads, objects.size() + active.size(), [&](std::size_t j) {
+    if (!scene_checked) detail::parallel_chunks(o.threads, objects.size() + active.size(), [&](std::size_t j) {
         if (j < objects.size()) {
             mesh_ok[j] = validate_mesh(objects[j]);
             return;

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <span>
 
+#include "cullide/cullide.h"
+#include "cullide/quick_cullide.h"
 #include "cullide/visibility.h"
 #include "cullide/mesh.h"
 #include "cullide/result.h"
@@ -50,10 +52,24 @@ inline constexpr std::size_t kTransformPart = 4096;
 // The checks every visibility method makes before drawing anything: option ranges, a valid scene,
 // `active` strictly increasing and in range, and every active object's coordinates inside the
 // exact range (with the ground truth's message, so all methods refuse alike). Returns the views'
-// size: the one place a method's resolution is checked and its default applied.
+// size: the one place a method's resolution is checked and its default applied. scene_checked:
+// the caller has checked every object already (validate_mesh and validate_exact_range_of, as
+// process_frame does before it runs a method), so those two scans are not repeated.
 [[nodiscard]] Result<ViewSize> check_visibility_inputs(std::span<const Mesh> objects,
                                                        std::span<const std::uint32_t> active,
-                                                       const VisibilityOptions& o, VisibilityMode mode);
+                                                       const VisibilityOptions& o, VisibilityMode mode,
+                                                       bool scene_checked = false);
+
+// cullide_pairs and quick_cullide_pairs for a caller that has checked the scene (scene_checked as
+// above); the public functions are these with scene_checked = false.
+[[nodiscard]] Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects,
+                                                              std::span<const std::uint32_t> active,
+                                                              const CullideOptions& options, QueryDevice& device,
+                                                              CullideStats* stats, bool scene_checked);
+[[nodiscard]] Result<std::vector<TrianglePair>> quick_cullide_pairs(std::span<const Mesh> objects,
+                                                                    std::span<const std::uint32_t> active,
+                                                                    const QuickOptions& options, QueryDevice& device,
+                                                                    QuickStats* stats, bool scene_checked);
 
 // The order of one recorded Quick-CULLIDE pass over n items (quick_cullide.cpp, and the recorded
 // form of raster::WindowedPasses): forward, for k = 0 .. n-1, query(k), then write(d) for every item

@@ -10,6 +10,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "cullide_detail.h"
 #include "emulator_device.h"
 #include "exact_stage.h"
 #include "parallel.h"
@@ -148,7 +149,7 @@ Status run_visibility(std::span<const Mesh> objects, const std::vector<std::uint
         qo.mode = o.method == Method::QCullide ? VisibilityMode::ExactBounds : VisibilityMode::GLExact;
         qo.self = o.self;
         QuickStats qs;
-        pairs = quick_cullide_pairs(objects, active, qo, *device, &qs);
+        pairs = detail::quick_cullide_pairs(objects, active, qo, *device, &qs, true);  // checked by process_frame
         static_cast<VisibilityStats&>(st) = std::move(qs);
         st.subobject_pairs = qs.item_pairs_kept;
         // With self-collision no object leaves at object level (it may collide with itself).
@@ -162,7 +163,7 @@ Status run_visibility(std::span<const Mesh> objects, const std::vector<std::uint
         co.min_prune = o.min_prune;
         co.object_stage = o.object_stage;
         CullideStats cs;
-        pairs = cullide_pairs(objects, active, co, *device, &cs);
+        pairs = detail::cullide_pairs(objects, active, co, *device, &cs, true);  // checked by process_frame
         static_cast<VisibilityStats&>(st) = std::move(cs);
         st.subobject_pairs = cs.subobject_pairs;
     }

@@ -55,10 +55,10 @@ struct Item {
 };
 
 Result<ViewSize> check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
-                              const QuickOptions& o) {
+                              const QuickOptions& o, bool scene_checked) {
     if (o.mode == VisibilityMode::Offset)
         return Error{"Quick-CULLIDE runs in GL-exact or exact-bounds mode, not with offset solids"};
-    return detail::check_visibility_inputs(objects, active, o, o.mode);
+    return detail::check_visibility_inputs(objects, active, o, o.mode, scene_checked);
 }
 
 std::uint64_t count_live(const std::vector<Item>& items) {
@@ -619,7 +619,14 @@ Result<std::vector<TrianglePair>> quick_cullide_pairs(std::span<const Mesh> obje
                                                       std::span<const std::uint32_t> active,
                                                       const QuickOptions& options, QueryDevice& device,
                                                       QuickStats* stats) {
-    Result<ViewSize> checked = check_inputs(objects, active, options);
+    return detail::quick_cullide_pairs(objects, active, options, device, stats, false);
+}
+
+Result<std::vector<TrianglePair>> detail::quick_cullide_pairs(std::span<const Mesh> objects,
+                                                              std::span<const std::uint32_t> active,
+                                                              const QuickOptions& options, QueryDevice& device,
+                                                              QuickStats* stats, bool scene_checked) {
+    Result<ViewSize> checked = check_inputs(objects, active, options, scene_checked);
     if (!checked) return checked.error();
     const ViewSize size = checked.value();
     QuickStats st;
