@@ -171,7 +171,7 @@ inline std::uint32_t quantize_up(double z, DepthFormat format) {
 // fragments (quantize_up(zhi + margin_z) as bounds_depth_range bounds zhi). ok = false when an index
 // or vertex fails the input checks (nothing is marked; the front end reports it).
 struct BoundsReach {
-    int x0 = 0, y0 = 0, x1 = -1, y1 = -1;  // the one box, when single and not empty
+    int x0 = 0, y0 = 0, x1 = -1, y1 = -1;  // the one box (single and not empty), the box() call's
     std::uint32_t zq_hi = 0xffffffffu;
     bool ok = true;
     bool single = true;  // one box (or none: nothing reaches the target)
@@ -214,8 +214,9 @@ BoundsReach bounds_reach(const FrontEndParams& params, const MeshViewD& mesh, De
     const double w1 = static_cast<double>(params.target_width - 1), h1 = static_cast<double>(params.target_height - 1);
     r.empty = false;
     if (absmax > 2.0) {  // large magnitudes: clipping's rounding scales with M; the whole target
-        box(0, 0, params.target_width - 1, params.target_height - 1);
-        return r;
+        r.x0 = 0, r.y0 = 0, r.x1 = params.target_width - 1, r.y1 = params.target_height - 1;
+        box(r.x0, r.y0, r.x1, r.y1);
+        return r;  // (zq_hi stays the largest value: never alone)
     }
     // Every triangle's margins are at most m and mz (its M <= max(1, absmax)). With |v| <= 1 < lim
     // setup_bounds_triangle takes each triangle unclipped with window coordinates v * (w / 2) + (x0 +

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -54,14 +55,17 @@ constexpr std::uint64_t kSplitRunsPerThread = 4;
 // triangle, and spares the setup and drawing of the items alone. It paid on the cloth (90% of the
 // first sub-object view's triangles spared: rcullide 1.20 -> 0.83 ms a frame at 2 threads) and on
 // leaves (39%: within 2%), and cost 5-20% where few items are alone (cylinders, tori, bunny-dragon,
-// breaking: 8-16%). So it runs while the calls of at least kAloneMinTriangles triangles among the
-// last kAloneWindow that ran it spared at least kAloneMinSpared of their triangles, and otherwise on
-// every kAloneProbe-th such call, to notice when the scene changes (every 8th call cost those scenes
-// 1-6%, every 32nd under 1%). Only the work depends on it, never an answer.
+// breaking: 8-16%). So each shape of call (its item count and triangle count, each rounded to a
+// power of two: a method's stages call with their own shapes, frame after frame) keeps the share
+// of triangles its last pre-pass spared; a call runs the pre-pass when its shape has none yet or
+// spared at least kAloneMinSpared, and otherwise after 2, 4, ... up to kAloneProbe calls without it
+// (doubling after each run that did not pay), to notice when the scene changes (a probe every 8th
+// call cost those scenes 1-6%, every 32nd under 1%). Calls of fewer than kAloneMinTriangles
+// triangles always run it (cheap either way). Only the work depends on it, never an answer.
 constexpr std::uint64_t kAloneMinTriangles = 1024;
-constexpr std::size_t kAloneWindow = 8;
 constexpr double kAloneMinSpared = 0.3;
 constexpr unsigned kAloneProbe = 32;
+constexpr std::size_t kAloneShapes = 64;
 
 
 std::string check_vertex(const Double4& d) {
@@ -152,6 +156,75 @@ struct OccGrid {
     [[nodiscard]] std::size_t count() const { return static_cast<std::size_t>(x) * static_cast<std::size_t>(y); }
 };
 
+// The cells of the pixel box [x0, x1] x [y0, y1] reached by `key` (an object, or a window).
+template <class Key>
+void occ_mark(const OccGrid& g, Key* key, std::uint8_t* state, int x0, int y0, int x1, int y1, Key k) {
+    for (int cy = y0 >> g.shift; cy <= y1 >> g.shift; ++cy) {
+        const std::size_t row = static_cast<std::size_t>(cy) * static_cast<std::size_t>(g.x);
+        for (int cx = x0 >> g.shift; cx <= x1 >> g.shift; ++cx) {
+            const std::size_t c = row + static_cast<std::size_t>(cx);
+            if (state[c] == kOccNone) {
+                state[c] = kOccOne;
+                key[c] = k;
+            } else if (key[c] != k) {
+                state[c] = kOccMany;
+            }
+        }
+    }
+}
+
+// Whether every cell of the pixel box is reached by one key only.
+inline bool occ_one(const OccGrid& g, const std::uint8_t* state, int x0, int y0, int x1, int y1) {
+    for (int cy = y0 >> g.shift; cy <= y1 >> g.shift; ++cy) {
+        const std::size_t row = static_cast<std::size_t>(cy) * static_cast<std::size_t>(g.x);
+        for (int cx = x0 >> g.shift; cx <= x1 >> g.shift; ++cx)
+            if (state[row + static_cast<std::size_t>(cx)] != kOccOne) return false;
+    }
+    return true;
+}
+
+// Whether an item is alone, from its reach (cells as marked): it reaches nothing, or its one box's
+// cells hold its key only and no fragment of it reaches the clear value. (Items of scattered
+// triangles, several boxes, are always drawn.)
+inline bool occ_alone(const OccGrid& g, const std::uint8_t* state, const detail::BoundsReach& r, std::uint32_t clear) {
+    if (!r.ok) return false;
+    if (r.empty) return true;
+    return r.single && r.zq_hi < clear && occ_one(g, state, r.x0, r.y0, r.x1, r.y1);
+}
+
+// When the items-alone pre-pass runs (kAloneMinSpared, kAloneProbe above): per shape of call, the
+// share its last pre-pass spared (negative: none yet) and the calls since.
+struct AloneGuard {
+    struct Shape {
+        double spared = -1.0;
+        unsigned off_calls = 0;  // calls without the pre-pass since it last ran
+        unsigned wait = 1;       // ... before it runs again: doubled after each run that did not pay
+    };
+    std::array<Shape, kAloneShapes> shapes{};
+    std::uint64_t last_spared = 0;  // the last call's spared triangles (0 without the pre-pass)
+
+    static std::size_t shape_of(std::size_t items, std::uint64_t triangles) {
+        return (static_cast<std::size_t>(std::bit_width(items)) * 67 + static_cast<std::size_t>(std::bit_width(triangles))) %
+               kAloneShapes;
+    }
+    bool wanted(std::size_t items, std::uint64_t submitted) {
+        last_spared = 0;
+        if (submitted < kAloneMinTriangles) return true;
+        Shape& sh = shapes[shape_of(items, submitted)];
+        if (sh.spared < 0.0 || sh.spared >= kAloneMinSpared) return true;
+        if (++sh.off_calls < sh.wait) return false;
+        sh.off_calls = 0;
+        return true;
+    }
+    void record(std::size_t items, std::uint64_t submitted, std::uint64_t spared_now) {
+        last_spared = spared_now;
+        if (submitted < kAloneMinTriangles) return;
+        Shape& sh = shapes[shape_of(items, submitted)];
+        sh.spared = static_cast<double>(spared_now) / static_cast<double>(submitted);
+        sh.wait = sh.spared >= kAloneMinSpared ? 1 : std::min(2 * sh.wait, kAloneProbe);
+    }
+};
+
 }  // namespace
 
 // run()'s phases, in order: reach and alone (the items that need drawing), front_end, bin, then
@@ -205,13 +278,8 @@ struct VisibilityPass::State {
     std::vector<std::uint8_t> occ_state;                   // per cell: kOccNone / kOccOne / kOccMany
     std::vector<std::vector<std::uint32_t>> part_occ_obj;  // split_pass: per part, its own cells
     std::vector<std::vector<std::uint8_t>> part_occ_state;
-    // The pre-pass's recent record (kAloneWindow calls): triangles submitted and spared.
-    std::array<std::uint64_t, kAloneWindow> alone_tris{}, alone_spared{};
-    std::uint64_t last_spared = 0;  // the last run's spared triangles (0 without the pre-pass)
-    std::size_t alone_next = 0;
-    unsigned alone_off_calls = 0;
-    // Whether this call of `submitted` triangles runs the pre-pass; record() after it ran.
-    bool alone_wanted(std::uint64_t submitted);
+    AloneGuard guard;
+    // guard.record() after a call that ran the pre-pass.
     void alone_record(std::span<const VisibilityItem> items, std::uint64_t submitted);
     // Items [first, last): reach[i], and their reach marked into the cells obj / state.
     void mark(const detail::FrontEndParams& params, std::span<const VisibilityItem> items, DepthFormat format,
@@ -337,26 +405,11 @@ void VisibilityPass::State::depth_bounds(DepthFormat format, std::size_t n_items
 // same bit for bit. Cells are coarser than pixels on targets above 128 a side (a superset: more
 // items drawn, never fewer than needed). An item that fails an input check is never skipped, so the
 // front end still finds and reports it.
-bool VisibilityPass::State::alone_wanted(std::uint64_t submitted) {
-    if (submitted < kAloneMinTriangles) return true;  // cheap either way; not counted
-    std::uint64_t tris_sum = 0, spared_sum = 0;
-    for (std::size_t k = 0; k < kAloneWindow; ++k) {
-        tris_sum += alone_tris[k];
-        spared_sum += alone_spared[k];
-    }
-    if (static_cast<double>(spared_sum) >= kAloneMinSpared * static_cast<double>(tris_sum)) return true;
-    return ++alone_off_calls % kAloneProbe == 0;
-}
-
 void VisibilityPass::State::alone_record(std::span<const VisibilityItem> items, std::uint64_t submitted) {
     std::uint64_t spared = 0;
     for (std::size_t i = 0; i < items.size(); ++i)
         if (skip[i]) spared += items[i].mesh.indices.size() / 3;
-    last_spared = spared;
-    if (submitted < kAloneMinTriangles) return;
-    alone_tris[alone_next] = submitted;
-    alone_spared[alone_next] = spared;
-    alone_next = (alone_next + 1) % kAloneWindow;
+    guard.record(items.size(), submitted, spared);
 }
 
 void VisibilityPass::State::mark(const detail::FrontEndParams& params, std::span<const VisibilityItem> items,
@@ -365,34 +418,13 @@ void VisibilityPass::State::mark(const detail::FrontEndParams& params, std::span
     for (std::size_t i = first; i < last; ++i) {
         const std::uint32_t o = items[i].object;
         reach[i] = detail::bounds_reach(params, items[i].mesh, format, g.shift, [&](int x0, int y0, int x1, int y1) {
-            for (int cy = y0 >> g.shift; cy <= y1 >> g.shift; ++cy) {
-                const std::size_t row = static_cast<std::size_t>(cy) * static_cast<std::size_t>(g.x);
-                for (int cx = x0 >> g.shift; cx <= x1 >> g.shift; ++cx) {
-                    const std::size_t c = row + static_cast<std::size_t>(cx);
-                    if (state[c] == kOccNone) {
-                        state[c] = kOccOne;
-                        obj[c] = o;
-                    } else if (obj[c] != o) {
-                        state[c] = kOccMany;
-                    }
-                }
-            }
+            occ_mark(g, obj, state, x0, y0, x1, y1, o);
         });
     }
 }
 
 void VisibilityPass::State::alone(const OccGrid& g, DepthFormat format, std::size_t i) {
-    const detail::BoundsReach& r = reach[i];
-    // An item of scattered triangles (several boxes) is drawn: only the one-box case is tested.
-    bool lone = r.ok && (r.empty || (r.single && r.zq_hi < DepthTarget::encode_clear(1.0, format)));
-    if (lone && !r.empty) {
-        for (int cy = r.y0 >> g.shift; lone && cy <= r.y1 >> g.shift; ++cy) {
-            const std::size_t row = static_cast<std::size_t>(cy) * static_cast<std::size_t>(g.x);
-            for (int cx = r.x0 >> g.shift; cx <= r.x1 >> g.shift; ++cx)
-                lone = lone && occ_state[row + static_cast<std::size_t>(cx)] == kOccOne;
-        }
-    }
-    skip[i] = lone ? 1 : 0;
+    skip[i] = occ_alone(g, occ_state.data(), reach[i], DepthTarget::encode_clear(1.0, format)) ? 1 : 0;
 }
 
 void VisibilityPass::State::bin(std::span<const VisibilityItem> items, const TileGrid& grid, bool settle) {
@@ -688,7 +720,7 @@ void VisibilityPass::State::raster_part(std::span<const VisibilityItem> items, c
 }
 
 VisibilityPass::VisibilityPass() : s_(std::make_unique<State>()) {}
-std::uint64_t VisibilityPass::last_spared_triangles() const { return s_->last_spared; }
+std::uint64_t VisibilityPass::last_spared_triangles() const { return s_->guard.last_spared; }
 VisibilityPass::~VisibilityPass() = default;
 
 Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, DepthFormat format,
@@ -710,8 +742,7 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
     for (const VisibilityItem& it : items) submitted += it.mesh.indices.size() / 3;
     const int one_side = tile_side(width, height);
     const bool one_tile = one_side >= width && one_side >= height;
-    const bool use_alone = s.alone_wanted(submitted);
-    s.last_spared = 0;
+    const bool use_alone = s.guard.wanted(items.size(), submitted);
     if (one_tile && threads > 1 && submitted >= kSplitMinTriangles * static_cast<std::uint64_t>(threads)) {
         // A few runs per thread, so that runs of small and of large triangles even out between them.
         const std::size_t parts = static_cast<std::size_t>(std::min<std::uint64_t>(

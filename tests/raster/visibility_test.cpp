@@ -203,53 +203,61 @@ TEST_CASE("The fused visibility pass with large triangles (tiles settled from de
     CHECK(hidden > 10);
 }
 
+// Objects in separate places (a few overlapping), each item a small cluster of 4 triangles; some
+// items reach the far plane (kind 0), leave the clip volume by up to 2x (1) or far beyond (2), lie
+// wholly outside (3) or have their triangles scattered (4). far_alone counts the kind-0 items.
+Scene spread_scene(test::Rng& rng, int& far_alone) {
+    Scene s;
+    const int objects = 4 + static_cast<int>(rng.below(40));
+    s.objects = static_cast<std::uint32_t>(objects);
+    for (int o = 0; o < objects; ++o) {
+        const Double4 centre{rng.uniform(-0.95, 0.95), rng.uniform(-0.95, 0.95), rng.uniform(-0.9, 0.9), 1.0};
+        const int items = 1 + static_cast<int>(rng.below(30));
+        for (int it = 0; it < items; ++it) {
+            std::vector<std::uint32_t> idx;
+            const int kind = static_cast<int>(rng.below(12));
+            const Double4 c{centre.x + rng.uniform(-0.08, 0.08), centre.y + rng.uniform(-0.08, 0.08),
+                            kind == 0 ? 1.0 - rng.uniform(0.0, 1e-9) : centre.z + rng.uniform(-0.05, 0.05), 1.0};
+            for (int t = 0; t < 4; ++t) {
+                const auto base = static_cast<std::uint32_t>(s.vertices.size());
+                // Scattered items (kind 4): each triangle elsewhere, so one box would be too big
+                // and the pre-pass marks each triangle's own.
+                const Double4 tc = kind == 4 ? Double4{centre.x + rng.uniform(-0.5, 0.5), centre.y + rng.uniform(-0.5, 0.5),
+                                                       c.z, 1.0}
+                                             : c;
+                for (int k = 0; k < 3; ++k) {
+                    Double4 v{tc.x + rng.uniform(-0.02, 0.02), tc.y + rng.uniform(-0.02, 0.02),
+                              kind == 0 ? c.z : c.z + rng.uniform(-0.02, 0.02), 1.0};
+                    if (kind == 1 && k == 0) v.x = rng.coin() ? 1.6 : -1.9;  // clipped, |v| <= 2
+                    if (kind == 2 && k == 1) v.y = 3.5;                      // far beyond: whole target
+                    if (kind == 3) v.x += 2.5;                               // wholly outside
+                    s.vertices.push_back(v);
+                }
+                idx.insert(idx.end(), {base, base + 1, base + 2});
+            }
+            if (kind == 0) ++far_alone;
+            s.item_indices.push_back(std::move(idx));
+            s.item_object.push_back(static_cast<std::uint32_t>(o));
+        }
+    }
+    return s;
+}
+
 TEST_CASE("The fused visibility pass: items alone in the view are skipped with the recorded answers") {
     // visibility.cpp, State::alone: an item whose pixels no other object's triangle comes near is
     // neither set up nor drawn; its answer is 0 unless a fragment may reach the clear value. Objects
     // in separate places (a few overlapping), each item a small cluster; some items reach the far
     // plane (their query passes against the clear value even alone), some leave the clip volume by
     // up to 2x (clipped: the box from the vertices needs its extra pixel) or far beyond (the whole
-    // target), some lie wholly outside, some have their triangles scattered; 32^2 (one tile; split between threads), 37 x 23, and 300 x 200
-    // (cells of 4 pixels).
+    // target), some lie wholly outside, some have their triangles scattered (spread_scene); 32^2
+    // (one tile; split between threads), 37 x 23, and 300 x 200 (cells of 4 pixels).
     test::Rng rng(20261127);
     const DepthFormat formats[] = {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F};
     const int sizes[][2] = {{32, 32}, {37, 23}, {300, 200}};
     int visible = 0, hidden = 0, far_alone = 0;
     std::uint64_t spared_runs = 0;
     for (int rep = 0; rep < 18; ++rep) {
-        Scene s;
-        const int objects = 4 + static_cast<int>(rng.below(40));
-        s.objects = static_cast<std::uint32_t>(objects);
-        for (int o = 0; o < objects; ++o) {
-            const Double4 centre{rng.uniform(-0.95, 0.95), rng.uniform(-0.95, 0.95), rng.uniform(-0.9, 0.9), 1.0};
-            const int items = 1 + static_cast<int>(rng.below(30));
-            for (int it = 0; it < items; ++it) {
-                std::vector<std::uint32_t> idx;
-                const int kind = static_cast<int>(rng.below(12));
-                const Double4 c{centre.x + rng.uniform(-0.08, 0.08), centre.y + rng.uniform(-0.08, 0.08),
-                                kind == 0 ? 1.0 - rng.uniform(0.0, 1e-9) : centre.z + rng.uniform(-0.05, 0.05), 1.0};
-                for (int t = 0; t < 4; ++t) {
-                    const auto base = static_cast<std::uint32_t>(s.vertices.size());
-                    // Scattered items (kind 4): each triangle elsewhere, so one box would be too big
-                    // and the pre-pass marks each triangle's own.
-                    const Double4 tc = kind == 4 ? Double4{centre.x + rng.uniform(-0.5, 0.5), centre.y + rng.uniform(-0.5, 0.5),
-                                                           c.z, 1.0}
-                                                 : c;
-                    for (int k = 0; k < 3; ++k) {
-                        Double4 v{tc.x + rng.uniform(-0.02, 0.02), tc.y + rng.uniform(-0.02, 0.02),
-                                  kind == 0 ? c.z : c.z + rng.uniform(-0.02, 0.02), 1.0};
-                        if (kind == 1 && k == 0) v.x = rng.coin() ? 1.6 : -1.9;  // clipped, |v| <= 2
-                        if (kind == 2 && k == 1) v.y = 3.5;                      // far beyond: whole target
-                        if (kind == 3) v.x += 2.5;                               // wholly outside
-                        s.vertices.push_back(v);
-                    }
-                    idx.insert(idx.end(), {base, base + 1, base + 2});
-                }
-                if (kind == 0) ++far_alone;
-                s.item_indices.push_back(std::move(idx));
-                s.item_object.push_back(static_cast<std::uint32_t>(o));
-            }
-        }
+        const Scene s = spread_scene(rng, far_alone);
         const DepthFormat f = formats[rep % 3];
         const int w = sizes[(rep / 3) % 3][0], h = sizes[(rep / 3) % 3][1];
         CAPTURE(rep);
@@ -570,6 +578,50 @@ TEST_CASE("WindowedPasses (each item rasterized once) give the recorded windowed
         }
     }
     // Both answers occur, so the comparison can fail either way.
+    CHECK(passed > 100);
+    CHECK(failed > 100);
+}
+
+TEST_CASE("WindowedPasses on spread scenes give the recorded answers") {
+    // The spread scenes of the fused pass's items-alone test (objects apart, items at the far plane,
+    // clipped, far beyond, outside, scattered) with object windows (Quick-CULLIDE without
+    // self-collision), bands (with it) and the mix; random query and write masks; 32^2, 37 x 23 and
+    // 300 x 200.
+    test::Rng rng(20261128);
+    const DepthFormat formats[] = {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F};
+    const int sizes[][2] = {{32, 32}, {37, 23}, {300, 200}};
+    int far_alone = 0, passed = 0, failed = 0;
+    for (int rep = 0; rep < 27; ++rep) {
+        const Scene s = spread_scene(rng, far_alone);
+        const std::size_t n = s.item_indices.size();
+        std::vector<std::uint32_t> lo, hi;
+        random_windows(rng, n, lo, hi, s.item_object);
+        std::vector<raster::WindowedItem> items(n);
+        std::vector<std::uint8_t> query(n), write(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            query[i] = rng.below(5) != 0 ? 1 : 0;
+            write[i] = rng.below(5) != 0 ? 1 : 0;
+            items[i] = {raster::MeshViewD{s.vertices, s.item_indices[i]}, lo[i], hi[i], query[i] != 0 || write[i] != 0};
+        }
+        const DepthFormat f = formats[rep % 3];
+        const int w = sizes[(rep / 3) % 3][0], h = sizes[(rep / 3) % 3][1];
+        CAPTURE(rep);
+        for (const int threads : {1, 3}) {
+            CAPTURE(threads);
+            raster::WindowedPasses passes;
+            auto prepared = passes.prepare(w, h, f, items, threads);
+            REQUIRE_MESSAGE(prepared.ok(), prepared.error().message);
+            for (const bool forward : {true, false}) {
+                CAPTURE(forward);
+                const std::vector<std::uint8_t> want = recorded_windowed(s, lo, hi, query, write, forward, w, h, f);
+                auto got = passes.run(forward, query, write);
+                REQUIRE_MESSAGE(got.ok(), got.error().message);
+                CHECK(got.value() == want);
+                for (std::size_t k = 0; k < n; ++k)
+                    if (query[k]) (want[k] != 0 ? passed : failed) += 1;
+            }
+        }
+    }
     CHECK(passed > 100);
     CHECK(failed > 100);
 }
