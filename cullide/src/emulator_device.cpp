@@ -55,6 +55,8 @@ Result<std::vector<raster::QueryResults>> EmulatorDevice::execute_cleared(
     // other tiles' work and while the tile is in that core's cache, without a pass of its own.
     raster::ExecuteOptions options = execute_options();
     options.clear_depth = 1.0;
+    // Only the results are wanted (query_device.h): draws that no query observes are skipped.
+    options.queries_only = true;
     raster::Result<std::vector<raster::QueryResults>> r = raster::execute_sequence(*target_, batches, options);
     if (!r) return Error{"emulator device: " + r.error().message};
     return std::move(r).value();

@@ -158,7 +158,205 @@ struct Draws {
     std::vector<std::size_t> first;     // per batch, and the total at the end
 };
 
-void draws(std::span<const CommandBatch* const> batches, int threads, Draws& d) {
+// ExecuteOptions::queries_only: which draw commands of a batch a query can observe.
+//
+// A draw changes the stored depth only at pixels it covers, and a query's count reads the stored
+// depth only at pixels its draws cover; so a write (depth mask on) matters only if a later query
+// of the batch covers one of its pixels, and a draw that neither writes nor counts for a query
+// matters not at all. On a batch that starts cleared to 1, a query draw with the mask off whose
+// pixels no earlier kept write covers meets 1 everywhere: with GEQUAL, GREATER or EQUAL and every
+// fragment's window depth below 1 (NEVER: always) no sample passes, so its count is 0 without
+// drawing it. Skipped writes are not counted as earlier writes: a later query's pixels do not meet
+// them (else they would be kept). So the query results are the same bit for bit; only the target's
+// final content differs (the option says so).
+//
+// "Covers" is taken from a box that holds every pixel the draw's GL-exact rasterization can touch:
+// orthographic input (every used vertex with w = 1) maps to window X = x * (w / 2) + (x0 + w / 2)
+// (the viewport; clipping only shrinks the triangle), a pixel is covered only if its centre is inside
+// the snapped triangle, so [floor(min X) - 1, ceil(max X) + 1] with a whole pixel of slack for the
+// snapping and the float arithmetic, cut to the target; the same in Y; and window depth z * 0.5 +
+// 0.5 (GL) or z (Vulkan's half-z), so the largest vertex depth bounds every fragment's up to the
+// plane's float rounding (far below the 2^-10 the test above keeps from 1). Draws of double input,
+// of exact bounds or with w != 1 cover the whole target at an unknown depth (never skipped by the
+// query rule). Pixels are grouped in square cells (8 x 8 at 1024^2: at most 128 a side), which can
+// only keep more draws.
+struct DrawReach {
+    int x0 = 0, y0 = 0, x1 = -1, y1 = -1;  // cells, inclusive; empty when x0 > x1
+    bool depth_known = false;
+    double zmax = 1.0;  // window depth bound
+};
+
+struct ObservedScratch {
+    std::vector<DrawReach> reach;      // per command
+    std::vector<std::uint32_t> query;  // per command: the active query, or kNoQuery
+};
+
+// Flags over the cells, with a coarse level (8 x 8 cells) so that a large box costs a few coarse
+// cells: `fine` per cell, and per coarse cell `some` (a fine flag or a large box is inside) and
+// `all` (a large box reached it: every cell counts as flagged). Both answers are supersets, which
+// can only keep more draws.
+// The cells: squares of 2^shift pixels, at most 128 a side; cx x cy of them.
+struct CellGrid {
+    int shift = 0;
+    std::size_t cx = 0, cy = 0;
+    explicit CellGrid(const DepthTarget& target) {
+        while ((std::max(target.width(), target.height()) + (1 << shift) - 1) >> shift > 128) ++shift;
+        cx = static_cast<std::size_t>(((target.width() - 1) >> shift) + 1);
+        cy = static_cast<std::size_t>(((target.height() - 1) >> shift) + 1);
+    }
+};
+
+class CellFlags {
+   public:
+    void reset(const CellGrid& g) { reset(g.cx, g.cy); }
+    void reset(std::size_t cx, std::size_t cy) {
+        cx_ = cx;
+        ccx_ = (cx + 7) / 8;
+        fine_.assign(cx * cy, 0);
+        some_.assign(ccx_ * ((cy + 7) / 8), 0);
+        all_.assign(some_.size(), 0);
+    }
+    [[nodiscard]] bool any(const DrawReach& r) const {
+        const bool large = (r.x1 - r.x0 + 1) * (r.y1 - r.y0 + 1) > kSmall;
+        for (int y = r.y0 >> 3; y <= r.y1 >> 3; ++y)
+            for (int x = r.x0 >> 3; x <= r.x1 >> 3; ++x) {
+                const std::size_t c = coarse(x, y);
+                if (all_[c] || (large && some_[c])) return true;
+            }
+        if (large) return false;
+        for (int y = r.y0; y <= r.y1; ++y)
+            for (int x = r.x0; x <= r.x1; ++x)
+                if (fine_[static_cast<std::size_t>(y) * cx_ + static_cast<std::size_t>(x)]) return true;
+        return false;
+    }
+    void mark(const DrawReach& r) {
+        const bool large = (r.x1 - r.x0 + 1) * (r.y1 - r.y0 + 1) > kSmall;
+        for (int y = r.y0 >> 3; y <= r.y1 >> 3; ++y)
+            for (int x = r.x0 >> 3; x <= r.x1 >> 3; ++x) {
+                some_[coarse(x, y)] = 1;
+                if (large) all_[coarse(x, y)] = 1;
+            }
+        if (large) return;
+        for (int y = r.y0; y <= r.y1; ++y)
+            for (int x = r.x0; x <= r.x1; ++x) fine_[static_cast<std::size_t>(y) * cx_ + static_cast<std::size_t>(x)] = 1;
+    }
+
+   private:
+    static constexpr int kSmall = 64;  // boxes of more cells go to the coarse level
+    [[nodiscard]] std::size_t coarse(int x, int y) const {
+        return static_cast<std::size_t>(y) * ccx_ + static_cast<std::size_t>(x);
+    }
+    std::size_t cx_ = 0, ccx_ = 0;
+    std::vector<std::uint8_t> fine_, some_, all_;
+};
+
+DrawReach draw_reach(const DepthTarget& target, RasterRules rules, const Command& c, int shift) {
+    DrawReach r;
+    const int cw = ((target.width() - 1) >> shift), ch = ((target.height() - 1) >> shift);
+    const auto whole = [&] {
+        r.x0 = 0, r.y0 = 0, r.x1 = cw, r.y1 = ch;
+        r.depth_known = false;
+        return r;
+    };
+    if (c.double_input || c.state.mode != RasterMode::GLExact) return whole();
+    const std::size_t n = c.mesh.indices.size() / 3 * 3;
+    if (n == 0) return r;
+    constexpr float kInf = __builtin_inff();
+    float x0 = kInf, x1 = -kInf, y0 = kInf, y1 = -kInf, z1 = -kInf;
+    bool ortho = true;
+    for (std::size_t k = 0; k < n; ++k) {
+        const Float4& v = c.mesh.vertices[c.mesh.indices[k]];
+        ortho = ortho && v.w == 1.0f;
+        x0 = std::min(x0, v.x), x1 = std::max(x1, v.x);
+        y0 = std::min(y0, v.y), y1 = std::max(y1, v.y);
+        z1 = std::max(z1, v.z);
+    }
+    if (!ortho) return whole();
+    const Viewport vp = c.state.viewport ? *c.state.viewport : Viewport{0, 0, target.width(), target.height()};
+    const double hw = vp.width * 0.5, hh = vp.height * 0.5;
+    const double wx0 = static_cast<double>(x0) * hw + (vp.x + hw), wx1 = static_cast<double>(x1) * hw + (vp.x + hw);
+    const double wy0 = static_cast<double>(y0) * hh + (vp.y + hh), wy1 = static_cast<double>(y1) * hh + (vp.y + hh);
+    const double w1 = target.width() - 1, h1 = target.height() - 1;
+    const double bx0 = std::max(std::floor(wx0) - 1.0, 0.0), bx1 = std::min(std::ceil(wx1) + 1.0, w1);
+    const double by0 = std::max(std::floor(wy0) - 1.0, 0.0), by1 = std::min(std::ceil(wy1) + 1.0, h1);
+    if (!(bx0 <= bx1 && by0 <= by1)) return r;  // outside the target: no pixel
+    r.x0 = static_cast<int>(bx0) >> shift, r.x1 = static_cast<int>(bx1) >> shift;
+    r.y0 = static_cast<int>(by0) >> shift, r.y1 = static_cast<int>(by1) >> shift;
+    r.depth_known = true;
+    r.zmax = rules == RasterRules::Vulkan ? static_cast<double>(z1) : static_cast<double>(z1) * 0.5 + 0.5;
+    return r;
+}
+
+// keep[i] = whether command i (a draw) must run; see above. The reaches are found in parallel
+// chunks of commands (each its own entries); the two sweeps are serial but touch cells only.
+// `read` holds the cells that queries after the batch may read (reset by the caller: empty when
+// the next batch starts on a cleared target) and is left holding the batch's own as well.
+void observed_draws(const DepthTarget& target, const CellGrid& grid, const CommandBatch& batch, bool cleared_to_one,
+                    int threads, ObservedScratch& s, CellFlags& read, std::vector<std::uint8_t>& keep) {
+    const auto& cmds = batch.commands();
+    s.reach.resize(cmds.size());
+    s.query.resize(cmds.size());
+    keep.assign(cmds.size(), 0);
+    std::uint32_t active = kNoQuery;
+    for (std::size_t i = 0; i < cmds.size(); ++i) {
+        if (cmds[i].kind == Command::Kind::BeginQuery) active = cmds[i].query;
+        else if (cmds[i].kind == Command::Kind::EndQuery) active = kNoQuery;
+        s.query[i] = active;
+    }
+    constexpr std::size_t kReachChunk = 1024;
+    detail::parallel_for(threads, (cmds.size() + kReachChunk - 1) / kReachChunk, [&](std::size_t chunk) {
+        const std::size_t end = std::min(cmds.size(), (chunk + 1) * kReachChunk);
+        for (std::size_t i = chunk * kReachChunk; i < end; ++i)
+            if (cmds[i].kind == Command::Kind::Draw) s.reach[i] = draw_reach(target, batch.rules(), cmds[i], grid.shift);
+    });
+    thread_local CellFlags written;
+    for (std::size_t i = cmds.size(); i-- > 0;) {  // backward: the writes a later query may read
+        if (cmds[i].kind != Command::Kind::Draw) continue;
+        const DrawReach& r = s.reach[i];
+        if (r.x0 > r.x1 || r.y0 > r.y1) continue;  // no pixel
+        const bool counted = s.query[i] != kNoQuery;
+        keep[i] = counted || (cmds[i].state.depth_write && read.any(r)) ? 1 : 0;
+        if (counted) read.mark(r);
+    }
+    if (!cleared_to_one) return;
+    written.reset(grid);
+    constexpr double kBelowClear = 1.0 - 0x1p-10;
+    for (std::size_t i = 0; i < cmds.size(); ++i) {  // forward: queries that meet only the clear value
+        if (!keep[i]) continue;
+        const Command& c = cmds[i];
+        const DrawReach& r = s.reach[i];
+        if (s.query[i] != kNoQuery && !c.state.depth_write) {
+            const DepthFunc f = c.state.depth_func;
+            const bool fails_on_clear =
+                f == DepthFunc::Never || ((f == DepthFunc::GEqual || f == DepthFunc::Greater || f == DepthFunc::Equal) &&
+                                          r.depth_known && r.zmax <= kBelowClear);
+            if (fails_on_clear && (f == DepthFunc::Never || !written.any(r))) {
+                keep[i] = 0;
+                continue;
+            }
+        }
+        if (c.state.depth_write) written.mark(r);
+    }
+}
+
+void draws(std::span<const CommandBatch* const> batches, int threads, Draws& d, const DepthTarget& target,
+           const ExecuteOptions& options) {
+    thread_local ObservedScratch observed;
+    thread_local CellFlags read;
+    thread_local std::vector<std::vector<std::uint8_t>> keeps;
+    const bool cleared_to_one = options.clear_depth && *options.clear_depth >= 1.0;
+    if (options.queries_only) {
+        // Each batch on a cleared target (clear_depth): its queries read only its own writes.
+        // Otherwise a batch starts on the one before's depth, so a write is kept when a query of
+        // its own or of any later batch may read it: the batches from the last, the cells carried.
+        if (keeps.size() < batches.size()) keeps.resize(batches.size());
+        const CellGrid grid(target);
+        read.reset(grid);
+        for (std::size_t k = batches.size(); k-- > 0;) {
+            if (options.clear_depth) read.reset(grid);
+            observed_draws(target, grid, *batches[k], cleared_to_one, threads, observed, read, keeps[k]);
+        }
+    }
     d.cmd.clear();
     d.index.clear();
     d.query.clear();
@@ -166,15 +364,19 @@ void draws(std::span<const CommandBatch* const> batches, int threads, Draws& d) 
     d.k0.clear();
     d.k1.clear();
     d.first.clear();
-    for (const CommandBatch* batch : batches) {
+    for (std::size_t b = 0; b < batches.size(); ++b) {
+        const CommandBatch* batch = batches[b];
         d.first.push_back(d.cmd.size());
         const auto& cmds = batch->commands();
+        const std::uint8_t* keep = options.queries_only ? keeps[b].data() : nullptr;
         std::uint32_t active = kNoQuery;
         for (std::size_t i = 0; i < cmds.size(); ++i) {
             if (cmds[i].kind == Command::Kind::BeginQuery) {
                 active = cmds[i].query;
             } else if (cmds[i].kind == Command::Kind::EndQuery) {
                 active = kNoQuery;
+            } else if (keep != nullptr && !keep[i]) {
+                continue;  // no query observes it
             } else {
                 const Command& c = cmds[i];
                 const std::size_t n = c.double_input ? c.mesh_d.indices.size() : c.mesh.indices.size();
@@ -566,7 +768,7 @@ Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::spa
     // One front end for the whole sequence: a triangle list is set up once for every draw of any
     // batch with the same spans and front-end state (share_setup). Every batch's spans are alive
     // and unchanged for the whole call (the lifetime rule of raster/types.h), so this is exact.
-    draws(batches, threads, draw_list);
+    draws(batches, threads, draw_list, target, options);
     share_setup(target, draw_list, scratch.setup, scratch.setup_index);
     front_end(target, draw_list, threads, scratch.setup, scratch.own_setup);
     const SetupDraws& setup = scratch.setup;

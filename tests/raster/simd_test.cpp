@@ -796,6 +796,159 @@ TEST_CASE("execute_sequence == execute per batch with the clear between, and an 
     CHECK(outer.value()[1] == want.value());
 }
 
+// ExecuteOptions::queries_only (execute.cpp, observed_draws): draws that no query can observe are
+// skipped, with the same query results. Random sequences of CULLIDE-like passes over clusters of
+// items in separate places (so that most draws are unobserved) and some overlapping, plus draws of
+// every kind the rules must keep: queries with the mask on, NEVER / LESS / GREATER / EQUAL /
+// ALWAYS queries, samples-passed counts, items at the far plane (z = 1: GEQUAL passes on the clear
+// value) and beyond it (clipped there), w != 1, outside the target, viewports, exact-bounds
+// double input, Vulkan's rules; with clear_depth = 1 (both rules) and without (writes only), with
+// written_tiles kept across calls as the emulator device keeps them; 1, 2 and 3 threads.
+TEST_CASE("queries_only skips unobserved draws with the same query results") {
+    raster_test::SplitMix64 rng(0x9a11u);
+    int differs = 0, runs = 0;
+    for (int rep = 0; rep < 24; ++rep) {
+        const int w = rep % 3 == 0 ? 64 : rep % 3 == 1 ? 130 : 300, h = rep % 2 == 0 ? 64 : 90;
+        const raster::RasterRules rules = rep % 4 == 3 ? raster::RasterRules::Vulkan : raster::RasterRules::GlLlvmpipe;
+        std::vector<raster::Float4> v;
+        std::vector<raster::Double4> vd;
+        std::vector<std::uint32_t> idx;
+        std::vector<std::size_t> item_start;  // items: 2 triangles each
+        const int clusters = 3 + static_cast<int>(rng.below(6));
+        for (int c = 0; c < clusters; ++c) {
+            const float cx = rng.uniform(-0.9f, 0.9f), cy = rng.uniform(-0.9f, 0.9f), cz = rng.uniform(-0.8f, 0.8f);
+            const int items = 1 + static_cast<int>(rng.below(12));
+            for (int it = 0; it < items; ++it) {
+                item_start.push_back(idx.size());
+                const int kind = static_cast<int>(rng.below(10));
+                for (int t = 0; t < 2; ++t) {
+                    for (int k = 0; k < 3; ++k) {
+                        raster::Float4 p{cx + rng.uniform(-0.12f, 0.12f), cy + rng.uniform(-0.12f, 0.12f),
+                                         cz + rng.uniform(-0.1f, 0.1f), 1.0f};
+                        if (kind == 0) p.z = 1.0f;                      // at the far plane
+                        if (kind == 1 && k == 0) p.z = 1.3f;            // beyond it: clipped at z = 1
+                        if (kind == 2) p.w = 1.5f, p.x *= 1.5f, p.y *= 1.5f;  // w != 1
+                        if (kind == 3) p.x += 2.5f;                     // outside the target
+                        if (kind == 4) p.x = cx + rng.uniform(-1.0f, 1.0f);  // wide
+                        idx.push_back(static_cast<std::uint32_t>(v.size()));
+                        v.push_back(p);
+                        vd.push_back({p.x, p.y, p.z, p.w});
+                    }
+                }
+            }
+        }
+        for (auto& d : vd) d.w = 1.0;  // (exact bounds take w = 1 only)
+        const std::size_t n_items = item_start.size();
+        const auto item = [&](std::size_t i) { return std::span<const std::uint32_t>(idx).subspan(item_start[i], 6); };
+        std::vector<raster::CommandBatch> batches;
+        for (int b = 0; b < 2; ++b) {  // the two passes: forward, backward
+            raster::CommandBatch batch(w, h, rules);
+            for (std::size_t n = 0; n < n_items; ++n) {
+                const std::size_t i = b == 0 ? n : n_items - 1 - n;
+                raster::DrawState q;
+                q.depth_func = DepthFunc::GEqual;
+                q.depth_write = false;
+                const std::uint32_t extra = rng.below(20);
+                if (extra == 0) q.depth_func = DepthFunc::Never;
+                if (extra == 1) q.depth_func = DepthFunc::Less;
+                if (extra == 2) q.depth_func = DepthFunc::Greater;
+                if (extra == 3) q.depth_func = DepthFunc::Equal;
+                if (extra == 4) q.depth_func = DepthFunc::Always;
+                if (extra == 5) q.depth_write = true;  // a query that writes
+                if (extra == 6) q.viewport = raster::Viewport{w / 4, h / 4, w / 2, h / 2};
+                batch.begin_query(extra == 7 ? raster::QueryKind::SamplesPassed : raster::QueryKind::AnySamplesPassed);
+                if (extra == 8) {
+                    raster::DrawState e = q;
+                    e.mode = raster::RasterMode::ExactBounds;
+                    batch.draw(raster::MeshViewD{vd, item(i)}, e);
+                } else {
+                    batch.draw(raster::MeshView{v, item(i)}, q);
+                }
+                batch.end_query();
+                raster::DrawState wr;
+                wr.depth_func = extra == 9 ? DepthFunc::Always : DepthFunc::LEqual;
+                if (extra != 10) batch.draw(raster::MeshView{v, item(i)}, wr);  // (10: never written)
+                if (extra == 11) {  // a draw that neither writes nor counts
+                    raster::DrawState none = q;
+                    none.depth_write = false;
+                    batch.draw(raster::MeshView{v, item(i)}, none);
+                }
+            }
+            batches.push_back(std::move(batch));
+        }
+        std::vector<const raster::CommandBatch*> ptrs;
+        for (const auto& b : batches) ptrs.push_back(&b);
+        for (const auto f : kFormats) {
+            for (const bool cleared : {true, false}) {
+                auto want_t = raster::DepthTarget::create(w, h, f).value();
+                raster::ExecuteOptions full{1, true};
+                if (cleared) full.clear_depth = 1.0;
+                const auto want = raster::execute_sequence(want_t, ptrs, full);
+                REQUIRE(want.ok());
+                for (const int threads : {1, 2, 3}) {
+                    CAPTURE(rep);
+                    CAPTURE(static_cast<int>(f));
+                    CAPTURE(cleared);
+                    CAPTURE(threads);
+                    auto t = raster::DepthTarget::create(w, h, f).value();
+                    std::vector<std::uint8_t> written;
+                    raster::ExecuteOptions o{threads, true};
+                    o.queries_only = true;
+                    if (cleared) {
+                        o.clear_depth = 1.0;
+                        o.written_tiles = &written;
+                    }
+                    // Cleared: twice on one target, as the emulator device runs view after view
+                    // (the target's content after a call is unspecified, so without clear_depth a
+                    // second call would start from it).
+                    for (int call = 0; call < (cleared ? 2 : 1); ++call) {
+                        const auto got = raster::execute_sequence(t, ptrs, o);
+                        REQUIRE(got.ok());
+                        CHECK(got.value() == want.value());
+                    }
+                    ++runs;
+                    if (!std::equal(t.values().begin(), t.values().end(), want_t.values().begin(), want_t.values().end()))
+                        ++differs;
+                }
+            }
+        }
+    }
+    // Draws were skipped (the final depth is not full execution's) in most runs.
+    CHECK(differs > runs / 2);
+}
+
+TEST_CASE("queries_only: a write that shares one pixel column with a later query is kept") {
+    // On 64 x 64 (one pixel = 1/32 of clip space): W covers the pixel centres of columns 12..19,
+    // Q (behind it, queried after it) those of columns 5..12. They share column 12 only, where Q's
+    // GEQUAL query passes against W's depth; without W it would meet the clear value and fail. A
+    // reach box 4 pixels too tight on either side (past both boxes' pixel of slack) skips W and
+    // answers 0 (checked by mutation).
+    const auto X = [](double px) { return static_cast<float>(px / 32.0 - 1.0); };  // window X -> clip x
+    const std::vector<raster::Float4> v = {{X(12.2), X(30), -0.5f, 1}, {X(20), X(30), -0.5f, 1}, {X(12.2), X(34), -0.5f, 1},
+                                           {X(5), X(30), 0.5f, 1},     {X(12.8), X(30), 0.5f, 1}, {X(12.8), X(34), 0.5f, 1}};
+    const std::vector<std::uint32_t> wi = {0, 1, 2}, qi = {3, 4, 5};
+    for (const auto f : kFormats) {
+        raster::CommandBatch batch(64, 64);
+        batch.draw(raster::MeshView{v, wi}, raster::DrawState{});  // LESS, mask on
+        raster::DrawState q;
+        q.depth_func = DepthFunc::GEqual;
+        q.depth_write = false;
+        batch.begin_query(raster::QueryKind::SamplesPassed);
+        batch.draw(raster::MeshView{v, qi}, q);
+        batch.end_query();
+        auto t = raster::DepthTarget::create(64, 64, f).value();
+        raster::ExecuteOptions o{1, true};
+        o.clear_depth = 1.0;
+        const auto want = raster::execute(t, batch, o);
+        REQUIRE(want.ok());
+        REQUIRE(want.value()[0] > 0);  // column 12's pixels under both
+        o.queries_only = true;
+        const auto got = raster::execute(t, batch, o);
+        REQUIRE(got.ok());
+        CHECK(got.value() == want.value());
+    }
+}
+
 TEST_CASE("setup_range (each vertex transformed once, 8 triangles at a time) == setup_triangle per triangle, both rule sets and cullings") {
     // Random vertex lists of every flavour scene_gen makes (off-screen, near/far crossing, w < 0, the
     // 1/256 grid), indexed both ways: many triangles over a short list (the per-vertex path) and few

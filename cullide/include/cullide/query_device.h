@@ -52,8 +52,10 @@ class QueryDevice {
     // Each batch on a freshly cleared width x height target of `format`, in order: the results of
     // clear then execute for each batch in turn (the default does exactly that). All batches are
     // recorded before the call, so a device may share work between them: the emulator sets each
-    // triangle up once for all of them (raster::execute_sequence). Fails as clear and execute fail;
-    // the emulator validates every batch before running any.
+    // triangle up once for all of them (raster::execute_sequence), and skips the draws that no query
+    // can observe (ExecuteOptions::queries_only: the same results). Only the results are defined:
+    // the target's content afterwards is unspecified (clear before the next execute). Fails as clear
+    // and execute fail; the emulator validates every batch before running any.
     [[nodiscard]] virtual Result<std::vector<raster::QueryResults>> execute_cleared(
         int width, int height, raster::DepthFormat format, std::span<const raster::CommandBatch* const> batches);
 

@@ -93,6 +93,16 @@ struct ExecuteOptions {
     // tile is flagged (its content is unknown). Must be finite (values outside [0, 1] clamp, as
     // DepthTarget::clear).
     std::optional<double> clear_depth = std::nullopt;
+    // When set, only the query results are wanted: a draw that no query can observe is skipped,
+    // and the target's content afterwards is unspecified (written_tiles still flags every tile a
+    // draw wrote, so clear_depth's restoring stays exact). The results are the same bit for bit.
+    // Skipped: a draw outside every query that writes no pixel a later query of its batch may
+    // cover (or writes nothing); and, with clear_depth = 1, a GL-exact draw inside a query, with the
+    // mask off, whose test cannot pass against the clear value (GEQUAL, GREATER or EQUAL with every
+    // fragment's depth below 1, or NEVER) at pixels no earlier kept write of its batch may cover.
+    // "May cover": a box around the draw's vertices, in cells of up to 8 x 8 pixels (execute.cpp,
+    // observed_draws). CULLIDE's recorded passes (the emulator device's execute_cleared) set it.
+    bool queries_only = false;
 };
 
 // The side of execute()'s tiles (ExecuteOptions::written_tiles).
