@@ -520,6 +520,27 @@ std::vector<std::uint8_t> recorded_windowed(const Scene& s, const std::vector<st
     return passed;
 }
 
+// prepare() with `threads`, then both passes against recorded_windowed; counts the queried items'
+// answers (passed, failed) when `count`.
+void check_windowed(raster::WindowedPasses& passes, const Scene& s, const std::vector<raster::WindowedItem>& items,
+                    const std::vector<std::uint32_t>& lo, const std::vector<std::uint32_t>& hi,
+                    const std::vector<std::uint8_t>& query, const std::vector<std::uint8_t>& write, int w, int h,
+                    DepthFormat f, int threads, bool count, int& passed, int& failed) {
+    CAPTURE(threads);
+    auto prepared = passes.prepare(w, h, f, items, threads);
+    REQUIRE_MESSAGE(prepared.ok(), prepared.error().message);
+    for (const bool forward : {true, false}) {
+        CAPTURE(forward);
+        const std::vector<std::uint8_t> want = recorded_windowed(s, lo, hi, query, write, forward, w, h, f);
+        auto got = passes.run(forward, query, write);
+        REQUIRE_MESSAGE(got.ok(), got.error().message);
+        CHECK(got.value() == want);
+        if (count)
+            for (std::size_t k = 0; k < want.size(); ++k)
+                if (query[k]) (want[k] != 0 ? passed : failed) += 1;
+    }
+}
+
 }  // namespace
 
 TEST_CASE("WindowedPasses (each item rasterized once) give the recorded windowed passes' answers") {
@@ -561,21 +582,8 @@ TEST_CASE("WindowedPasses (each item rasterized once) give the recorded windowed
         const DepthFormat f = formats[rep % 3];
         const int w = sizes[(rep / 3) % 3][0], h = sizes[(rep / 3) % 3][1];
         CAPTURE(rep);
-        for (const int threads : {1, 2, 3, 8}) {
-            CAPTURE(threads);
-            auto prepared = passes.prepare(w, h, f, items, threads);
-            REQUIRE_MESSAGE(prepared.ok(), prepared.error().message);
-            for (const bool forward : {true, false}) {
-                CAPTURE(forward);
-                const std::vector<std::uint8_t> want = recorded_windowed(s, lo, hi, query, write, forward, w, h, f);
-                auto got = passes.run(forward, query, write);
-                REQUIRE_MESSAGE(got.ok(), got.error().message);
-                CHECK(got.value() == want);
-                if (threads == 1)
-                    for (std::size_t k = 0; k < n; ++k)
-                        if (query[k]) (want[k] != 0 ? passed : failed) += 1;
-            }
-        }
+        for (const int threads : {1, 2, 3, 8})
+            check_windowed(passes, s, items, lo, hi, query, write, w, h, f, threads, threads == 1, passed, failed);
     }
     // Both answers occur, so the comparison can fail either way.
     CHECK(passed > 100);
@@ -607,19 +615,8 @@ TEST_CASE("WindowedPasses on spread scenes give the recorded answers") {
         const int w = sizes[(rep / 3) % 3][0], h = sizes[(rep / 3) % 3][1];
         CAPTURE(rep);
         for (const int threads : {1, 3}) {
-            CAPTURE(threads);
             raster::WindowedPasses passes;
-            auto prepared = passes.prepare(w, h, f, items, threads);
-            REQUIRE_MESSAGE(prepared.ok(), prepared.error().message);
-            for (const bool forward : {true, false}) {
-                CAPTURE(forward);
-                const std::vector<std::uint8_t> want = recorded_windowed(s, lo, hi, query, write, forward, w, h, f);
-                auto got = passes.run(forward, query, write);
-                REQUIRE_MESSAGE(got.ok(), got.error().message);
-                CHECK(got.value() == want);
-                for (std::size_t k = 0; k < n; ++k)
-                    if (query[k]) (want[k] != 0 ? passed : failed) += 1;
-            }
+            check_windowed(passes, s, items, lo, hi, query, write, w, h, f, threads, true, passed, failed);
         }
     }
     CHECK(passed > 100);
