@@ -156,7 +156,7 @@ struct OccGrid {
     [[nodiscard]] std::size_t count() const { return static_cast<std::size_t>(x) * static_cast<std::size_t>(y); }
 };
 
-// The cells of the pixel box [x0, x1] x [y0, y1] reached by `key` (an object, or a window).
+// The cells of the pixel box [x0, x1] x [y0, y1] reached by the object `k`.
 template <class Key>
 void occ_mark(const OccGrid& g, Key* key, std::uint8_t* state, int x0, int y0, int x1, int y1, Key k) {
     for (int cy = y0 >> g.shift; cy <= y1 >> g.shift; ++cy) {
@@ -405,13 +405,6 @@ void VisibilityPass::State::depth_bounds(DepthFormat format, std::size_t n_items
 // same bit for bit. Cells are coarser than pixels on targets above 128 a side (a superset: more
 // items drawn, never fewer than needed). An item that fails an input check is never skipped, so the
 // front end still finds and reports it.
-void VisibilityPass::State::alone_record(std::span<const VisibilityItem> items, std::uint64_t submitted) {
-    std::uint64_t spared = 0;
-    for (std::size_t i = 0; i < items.size(); ++i)
-        if (skip[i]) spared += items[i].mesh.indices.size() / 3;
-    guard.record(items.size(), submitted, spared);
-}
-
 void VisibilityPass::State::mark(const detail::FrontEndParams& params, std::span<const VisibilityItem> items,
                                  DepthFormat format, const OccGrid& g, std::size_t first, std::size_t last,
                                  std::uint32_t* obj, std::uint8_t* state) {
@@ -425,6 +418,13 @@ void VisibilityPass::State::mark(const detail::FrontEndParams& params, std::span
 
 void VisibilityPass::State::alone(const OccGrid& g, DepthFormat format, std::size_t i) {
     skip[i] = occ_alone(g, occ_state.data(), reach[i], DepthTarget::encode_clear(1.0, format)) ? 1 : 0;
+}
+
+void VisibilityPass::State::alone_record(std::span<const VisibilityItem> items, std::uint64_t submitted) {
+    std::uint64_t spared = 0;
+    for (std::size_t i = 0; i < items.size(); ++i)
+        if (skip[i]) spared += items[i].mesh.indices.size() / 3;
+    guard.record(items.size(), submitted, spared);
 }
 
 void VisibilityPass::State::bin(std::span<const VisibilityItem> items, const TileGrid& grid, bool settle) {
@@ -576,22 +576,6 @@ void VisibilityPass::State::test_fragments(std::span<const VisibilityItem> items
     }
 }
 
-// The one-tile pass split by items (issue #16: R-CULLIDE's 32^2 views are one tile, so the tile
-// loop gave a second thread nothing). What the pass computes per pixel does not depend on the order
-// of the triangles: the minimum zmin over all objects and over the objects other than the one that
-// holds it. So the items are cut into `parts` runs of about equal triangle counts; each run sets its
-// items up and draws their triangles into the run's own minima (and its fragments into its own
-// list) in one task, so that the set-up triangles are drawn from the cache of the core that made
-// them; the runs' minima are merged pixel by pixel; then each run's fragments are tested against
-// the merged minima. Merging (m1, o1, m2) records keeps their meaning exactly: the smaller m1 wins
-// with its object, and m2 becomes the minimum over the objects other than that one, which from the
-// other record is its m2 if it holds the same object and its m1 otherwise. Every fragment then meets
-// the same value as in the serial pass, so hit[] is the same bit for bit, for any number of parts.
-//
-// Whether the tiles should rather be settled (large triangles) is known only once every item is set
-// up, so a run whose own triangles are large skips its drawing; if the whole pass turns out to
-// settle, the caller takes the settled path with the triangles as set up (any run's drawing is then
-// wasted work, never a different answer), and otherwise the skipped runs are drawn afterwards.
 // split_pass's marking: each part's reach into its own cells, in parallel, merged in part order
 // (kOccMany where two parts hold different objects): the same cells as one marking of every item.
 void VisibilityPass::State::mark_parts(const detail::FrontEndParams& params, std::span<const VisibilityItem> items,
@@ -623,6 +607,22 @@ void VisibilityPass::State::mark_parts(const detail::FrontEndParams& params, std
     }
 }
 
+// The one-tile pass split by items (issue #16: R-CULLIDE's 32^2 views are one tile, so the tile
+// loop gave a second thread nothing). What the pass computes per pixel does not depend on the order
+// of the triangles: the minimum zmin over all objects and over the objects other than the one that
+// holds it. So the items are cut into `parts` runs of about equal triangle counts; each run sets its
+// items up and draws their triangles into the run's own minima (and its fragments into its own
+// list) in one task, so that the set-up triangles are drawn from the cache of the core that made
+// them; the runs' minima are merged pixel by pixel; then each run's fragments are tested against
+// the merged minima. Merging (m1, o1, m2) records keeps their meaning exactly: the smaller m1 wins
+// with its object, and m2 becomes the minimum over the objects other than that one, which from the
+// other record is its m2 if it holds the same object and its m1 otherwise. Every fragment then meets
+// the same value as in the serial pass, so hit[] is the same bit for bit, for any number of parts.
+//
+// Whether the tiles should rather be settled (large triangles) is known only once every item is set
+// up, so a run whose own triangles are large skips its drawing; if the whole pass turns out to
+// settle, the caller takes the settled path with the triangles as set up (any run's drawing is then
+// wasted work, never a different answer), and otherwise the skipped runs are drawn afterwards.
 int VisibilityPass::State::split_pass(std::span<const VisibilityItem> items, const int side, const int width,
                                       const int height, const DepthFormat format, const int threads,
                                       const std::size_t n_parts, const bool use_alone) {
