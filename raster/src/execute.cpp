@@ -186,10 +186,25 @@ struct DrawReach {
     double zmax = 1.0;  // window depth bound
 };
 
-struct ObservedScratch {
-    std::vector<DrawReach> reach;      // per command
-    std::vector<std::uint32_t> query;  // per command: the active query, or kNoQuery
+// The units whose reach is taken: a draw command, or a piece of kObservePiece triangles of a big
+// GL-exact draw (so that the parts of a whole object far from every other object are skipped: the
+// cloth, the tree of leaves). Pieces keep the draw's order, state and query, as the front end's
+// pieces do (Draws), so a draw run as its kept pieces gives its results.
+constexpr std::size_t kObservePiece = 1024;
+struct ObservedUnit {
+    std::uint32_t cmd;
+    std::size_t k0, k1;  // its part of the command's index list
 };
+struct ObservedScratch {
+    std::vector<ObservedUnit> units;   // per batch, in command order
+    std::vector<DrawReach> reach;      // per unit
+    std::vector<std::uint32_t> query;  // per unit: the active query, or kNoQuery
+};
+
+// Whether draw command c is observed in pieces.
+bool observed_in_pieces(const Command& c) {
+    return c.state.mode == RasterMode::GLExact && !c.double_input && c.mesh.indices.size() > 3 * 3 * kObservePiece;
+}
 
 // Flags over the cells, with a coarse level (8 x 8 cells) so that a large box costs a few coarse
 // cells: `fine` per cell, and per coarse cell `some` (a fine flag or a large box is inside) and
@@ -250,7 +265,8 @@ class CellFlags {
     std::vector<std::uint8_t> fine_, some_, all_;
 };
 
-DrawReach draw_reach(const DepthTarget& target, RasterRules rules, const Command& c, int shift) {
+DrawReach draw_reach(const DepthTarget& target, RasterRules rules, const Command& c, std::size_t k0, std::size_t k1,
+                     int shift) {
     DrawReach r;
     const int cw = ((target.width() - 1) >> shift), ch = ((target.height() - 1) >> shift);
     const auto whole = [&] {
@@ -259,12 +275,12 @@ DrawReach draw_reach(const DepthTarget& target, RasterRules rules, const Command
         return r;
     };
     if (c.double_input || c.state.mode != RasterMode::GLExact) return whole();
-    const std::size_t n = c.mesh.indices.size() / 3 * 3;
-    if (n == 0) return r;
+    k1 = k0 + (k1 - k0) / 3 * 3;
+    if (k1 == k0) return r;
     constexpr float kInf = __builtin_inff();
     float x0 = kInf, x1 = -kInf, y0 = kInf, y1 = -kInf, z1 = -kInf;
     bool ortho = true;
-    for (std::size_t k = 0; k < n; ++k) {
+    for (std::size_t k = k0; k < k1; ++k) {
         const Float4& v = c.mesh.vertices[c.mesh.indices[k]];
         ortho = ortho && v.w == 1.0f;
         x0 = std::min(x0, v.x), x1 = std::max(x1, v.x);
@@ -294,44 +310,55 @@ DrawReach draw_reach(const DepthTarget& target, RasterRules rules, const Command
 void observed_draws(const DepthTarget& target, const CellGrid& grid, const CommandBatch& batch, bool cleared_to_one,
                     int threads, ObservedScratch& s, CellFlags& read, std::vector<std::uint8_t>& keep) {
     const auto& cmds = batch.commands();
-    s.reach.resize(cmds.size());
-    s.query.resize(cmds.size());
-    keep.assign(cmds.size(), 0);
+    s.units.clear();
+    s.query.clear();
     std::uint32_t active = kNoQuery;
     for (std::size_t i = 0; i < cmds.size(); ++i) {
-        if (cmds[i].kind == Command::Kind::BeginQuery) active = cmds[i].query;
-        else if (cmds[i].kind == Command::Kind::EndQuery) active = kNoQuery;
-        s.query[i] = active;
+        const Command& c = cmds[i];
+        if (c.kind == Command::Kind::BeginQuery) {
+            active = c.query;
+        } else if (c.kind == Command::Kind::EndQuery) {
+            active = kNoQuery;
+        } else {
+            const std::size_t n = c.double_input ? c.mesh_d.indices.size() : c.mesh.indices.size();
+            const std::size_t step = observed_in_pieces(c) ? 3 * kObservePiece : std::max<std::size_t>(n, 1);
+            for (std::size_t k = 0; k == 0 || k < n; k += step) {
+                s.units.push_back({static_cast<std::uint32_t>(i), k, std::min(n, k + step)});
+                s.query.push_back(active);
+            }
+        }
     }
-    constexpr std::size_t kReachChunk = 1024;
-    detail::parallel_for(threads, (cmds.size() + kReachChunk - 1) / kReachChunk, [&](std::size_t chunk) {
-        const std::size_t end = std::min(cmds.size(), (chunk + 1) * kReachChunk);
-        for (std::size_t i = chunk * kReachChunk; i < end; ++i)
-            if (cmds[i].kind == Command::Kind::Draw) s.reach[i] = draw_reach(target, batch.rules(), cmds[i], grid.shift);
+    const std::size_t n_units = s.units.size();
+    s.reach.resize(n_units);
+    keep.assign(n_units, 0);
+    constexpr std::size_t kReachChunk = 256;
+    detail::parallel_for(threads, (n_units + kReachChunk - 1) / kReachChunk, [&](std::size_t chunk) {
+        const std::size_t end = std::min(n_units, (chunk + 1) * kReachChunk);
+        for (std::size_t u = chunk * kReachChunk; u < end; ++u)
+            s.reach[u] = draw_reach(target, batch.rules(), cmds[s.units[u].cmd], s.units[u].k0, s.units[u].k1, grid.shift);
     });
     thread_local CellFlags written;
-    for (std::size_t i = cmds.size(); i-- > 0;) {  // backward: the writes a later query may read
-        if (cmds[i].kind != Command::Kind::Draw) continue;
-        const DrawReach& r = s.reach[i];
+    for (std::size_t u = n_units; u-- > 0;) {  // backward: the writes a later query may read
+        const DrawReach& r = s.reach[u];
         if (r.x0 > r.x1 || r.y0 > r.y1) continue;  // no pixel
-        const bool counted = s.query[i] != kNoQuery;
-        keep[i] = counted || (cmds[i].state.depth_write && read.any(r)) ? 1 : 0;
+        const bool counted = s.query[u] != kNoQuery;
+        keep[u] = counted || (cmds[s.units[u].cmd].state.depth_write && read.any(r)) ? 1 : 0;
         if (counted) read.mark(r);
     }
     if (!cleared_to_one) return;
     written.reset(grid);
     constexpr double kBelowClear = 1.0 - 0x1p-10;
-    for (std::size_t i = 0; i < cmds.size(); ++i) {  // forward: queries that meet only the clear value
-        if (!keep[i]) continue;
-        const Command& c = cmds[i];
-        const DrawReach& r = s.reach[i];
-        if (s.query[i] != kNoQuery && !c.state.depth_write) {
+    for (std::size_t u = 0; u < n_units; ++u) {  // forward: queries that meet only the clear value
+        if (!keep[u]) continue;
+        const Command& c = cmds[s.units[u].cmd];
+        const DrawReach& r = s.reach[u];
+        if (s.query[u] != kNoQuery && !c.state.depth_write) {
             const DepthFunc f = c.state.depth_func;
             const bool fails_on_clear =
                 f == DepthFunc::Never || ((f == DepthFunc::GEqual || f == DepthFunc::Greater || f == DepthFunc::Equal) &&
                                           r.depth_known && r.zmax <= kBelowClear);
             if (fails_on_clear && (f == DepthFunc::Never || !written.any(r))) {
-                keep[i] = 0;
+                keep[u] = 0;
                 continue;
             }
         }
@@ -369,26 +396,34 @@ void draws(std::span<const CommandBatch* const> batches, int threads, Draws& d, 
         d.first.push_back(d.cmd.size());
         const auto& cmds = batch->commands();
         const std::uint8_t* keep = options.queries_only ? keeps[b].data() : nullptr;
+        std::size_t unit = 0;  // with queries_only: the next unit of observed_draws, in the same order
         std::uint32_t active = kNoQuery;
         for (std::size_t i = 0; i < cmds.size(); ++i) {
             if (cmds[i].kind == Command::Kind::BeginQuery) {
                 active = cmds[i].query;
-            } else if (cmds[i].kind == Command::Kind::EndQuery) {
+                continue;
+            }
+            if (cmds[i].kind == Command::Kind::EndQuery) {
                 active = kNoQuery;
-            } else if (keep != nullptr && !keep[i]) {
-                continue;  // no query observes it
-            } else {
-                const Command& c = cmds[i];
-                const std::size_t n = c.double_input ? c.mesh_d.indices.size() : c.mesh.indices.size();
+                continue;
+            }
+            const Command& c = cmds[i];
+            const std::size_t n = c.double_input ? c.mesh_d.indices.size() : c.mesh.indices.size();
+            // The parts run: the whole list, or with queries_only its kept units (observed_draws).
+            const std::size_t step = keep != nullptr && observed_in_pieces(c) ? 3 * kObservePiece : std::max<std::size_t>(n, 1);
+            for (std::size_t u0 = 0; u0 == 0 || u0 < n; u0 += step) {
+                const std::size_t u1 = std::min(n, u0 + step);
+                if (keep != nullptr && !keep[unit++]) continue;  // no query observes it
+                // With several threads a big GL-exact part runs as pieces of kFrontEndPiece triangles.
                 const bool split = threads > 1 && c.state.mode == RasterMode::GLExact && !c.double_input &&
-                                   n > 3 * kFrontEndPiece;
-                for (std::size_t k = 0; k == 0 || (split && k < n); k += 3 * kFrontEndPiece) {
+                                   u1 - u0 > 3 * kFrontEndPiece;
+                for (std::size_t k = u0; k == u0 || (split && k < u1); k += 3 * kFrontEndPiece) {
                     d.cmd.push_back(&c);
                     d.index.push_back(static_cast<std::uint32_t>(i));
                     d.query.push_back(active);
                     d.rules.push_back(batch->rules());
                     d.k0.push_back(k);
-                    d.k1.push_back(split ? std::min(n, k + 3 * kFrontEndPiece) : n);
+                    d.k1.push_back(split ? std::min(u1, k + 3 * kFrontEndPiece) : u1);
                 }
             }
         }
