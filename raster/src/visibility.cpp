@@ -55,7 +55,7 @@ constexpr std::uint64_t kSplitRunsPerThread = 4;
 // triangle, and spares the setup and drawing of the items alone. It paid on the cloth (90% of the
 // first sub-object view's triangles spared: rcullide 1.20 -> 0.83 ms a frame at 2 threads) and on
 // leaves (39%: within 2%), and cost 5-20% where few items are alone (cylinders, tori, bunny-dragon,
-// breaking: 8-16%). So each shape of call (its item count and triangle count, each rounded to a
+// breaking: 8-16%). So each shape of call (its object, item and triangle counts, each rounded to a
 // power of two: a method's stages call with their own shapes, frame after frame) keeps the share
 // of triangles its last pre-pass spared; a call runs the pre-pass when its shape has none yet or
 // spared at least kAloneMinSpared, and otherwise after 2, 4, ... up to kAloneProbe calls without it
@@ -203,24 +203,29 @@ struct AloneGuard {
     std::array<Shape, kAloneShapes> shapes{};
     std::uint64_t last_spared = 0;  // the last call's spared triangles (0 without the pre-pass)
 
-    static std::size_t shape_of(std::size_t items, std::uint64_t triangles) {
-        return (static_cast<std::size_t>(std::bit_width(items)) * 67 + static_cast<std::size_t>(std::bit_width(triangles))) %
-               kAloneShapes;
+    // The shape of a call: its object, item and triangle counts, each rounded to a power of two.
+    struct Call {
+        std::size_t objects, items;
+        std::uint64_t triangles;
+    };
+    static std::size_t shape_of(const Call& c) {
+        const auto bw = [](std::uint64_t v) { return static_cast<std::size_t>(std::bit_width(v)); };
+        return (bw(c.objects) * 4099 + bw(c.items) * 67 + bw(c.triangles)) % kAloneShapes;
     }
-    bool wanted(std::size_t items, std::uint64_t submitted) {
+    bool wanted(const Call& call) {
         last_spared = 0;
-        if (submitted < kAloneMinTriangles) return true;
-        Shape& sh = shapes[shape_of(items, submitted)];
+        if (call.triangles < kAloneMinTriangles) return true;
+        Shape& sh = shapes[shape_of(call)];
         if (sh.spared < 0.0 || sh.spared >= kAloneMinSpared) return true;
         if (++sh.off_calls < sh.wait) return false;
         sh.off_calls = 0;
         return true;
     }
-    void record(std::size_t items, std::uint64_t submitted, std::uint64_t spared_now) {
+    void record(const Call& call, std::uint64_t spared_now) {
         last_spared = spared_now;
-        if (submitted < kAloneMinTriangles) return;
-        Shape& sh = shapes[shape_of(items, submitted)];
-        sh.spared = static_cast<double>(spared_now) / static_cast<double>(submitted);
+        if (call.triangles < kAloneMinTriangles) return;
+        Shape& sh = shapes[shape_of(call)];
+        sh.spared = static_cast<double>(spared_now) / static_cast<double>(call.triangles);
         sh.wait = sh.spared >= kAloneMinSpared ? 1 : std::min(2 * sh.wait, kAloneProbe);
     }
 };
@@ -280,7 +285,7 @@ struct VisibilityPass::State {
     std::vector<std::vector<std::uint8_t>> part_occ_state;
     AloneGuard guard;
     // guard.record() after a call that ran the pre-pass.
-    void alone_record(std::span<const VisibilityItem> items, std::uint64_t submitted);
+    void alone_record(std::span<const VisibilityItem> items, const AloneGuard::Call& call);
     // Items [first, last): reach[i], and their reach marked into the cells obj / state.
     void mark(const detail::FrontEndParams& params, std::span<const VisibilityItem> items, DepthFormat format,
               const OccGrid& g, std::size_t first, std::size_t last, std::uint32_t* obj, std::uint8_t* state);
@@ -420,11 +425,11 @@ void VisibilityPass::State::alone(const OccGrid& g, DepthFormat format, std::siz
     skip[i] = occ_alone(g, occ_state.data(), reach[i], DepthTarget::encode_clear(1.0, format)) ? 1 : 0;
 }
 
-void VisibilityPass::State::alone_record(std::span<const VisibilityItem> items, std::uint64_t submitted) {
+void VisibilityPass::State::alone_record(std::span<const VisibilityItem> items, const AloneGuard::Call& call) {
     std::uint64_t spared = 0;
     for (std::size_t i = 0; i < items.size(); ++i)
         if (skip[i]) spared += items[i].mesh.indices.size() / 3;
-    guard.record(items.size(), submitted, spared);
+    guard.record(call, spared);
 }
 
 void VisibilityPass::State::bin(std::span<const VisibilityItem> items, const TileGrid& grid, bool settle) {
@@ -742,7 +747,11 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
     for (const VisibilityItem& it : items) submitted += it.mesh.indices.size() / 3;
     const int one_side = tile_side(width, height);
     const bool one_tile = one_side >= width && one_side >= height;
-    const bool use_alone = s.guard.wanted(items.size(), submitted);
+    // The call's shape for the items-alone pre-pass's history (AloneGuard): the objects are the
+    // runs of equal object ids (each object's items are consecutive).
+    AloneGuard::Call call{0, items.size(), submitted};
+    for (std::size_t i = 0; i < items.size(); ++i) call.objects += i == 0 || items[i].object != items[i - 1].object;
+    const bool use_alone = s.guard.wanted(call);
     if (one_tile && threads > 1 && submitted >= kSplitMinTriangles * static_cast<std::uint64_t>(threads)) {
         // A few runs per thread, so that runs of small and of large triangles even out between them.
         const std::size_t parts = static_cast<std::size_t>(std::min<std::uint64_t>(
@@ -750,14 +759,14 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
         const int split =
             s.split_pass(items, one_side, width, height, format, threads, std::max<std::size_t>(parts, 2), use_alone);
         if (split == 0) return validate(items);
-        if (use_alone) s.alone_record(items, submitted);
+        if (use_alone) s.alone_record(items, call);
         if (split == 1)
             return std::vector<std::uint8_t>(s.hit.begin(), s.hit.begin() + static_cast<std::ptrdiff_t>(items.size()));
         // split == 2: large triangles, set up; the settled path below.
     } else if (!s.front_end(width, height, format, items, threads, use_alone)) {
         return validate(items);
     } else if (use_alone) {
-        s.alone_record(items, submitted);
+        s.alone_record(items, call);
     }
 
     std::uint64_t area = 0, count = 0;  // of the triangles' pixel boxes

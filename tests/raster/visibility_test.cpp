@@ -278,6 +278,48 @@ TEST_CASE("The fused visibility pass: items alone in the view are skipped with t
     CHECK(spared_runs == 18 * 4);  // every run found items alone
 }
 
+TEST_CASE("The fused visibility pass: the pre-pass's history of one scene does not turn it off for another") {
+    // visibility.cpp, AloneGuard: the pre-pass runs per shape of call while it pays. A pass object
+    // first serves many calls of a crowded scene (150 overlapping objects: nothing alone, so the
+    // pre-pass turns itself off for that shape), then a scene of 2 objects far apart with as many
+    // items and triangles (300 items, 1,200 triangles): its object count makes it another shape, so
+    // the pre-pass runs on its first call and spares every triangle.
+    test::Rng rng(20261129);
+    const auto make = [&](int objects, int items_per_object, double spread) {
+        Scene s;
+        s.objects = static_cast<std::uint32_t>(objects);
+        for (int o = 0; o < objects; ++o) {
+            const double cx = objects == 2 ? (o == 0 ? -0.6 : 0.6) : rng.uniform(-spread, spread);
+            const double cy = objects == 2 ? 0.0 : rng.uniform(-spread, spread);
+            for (int it = 0; it < items_per_object; ++it) {
+                std::vector<std::uint32_t> idx;
+                const Double4 c{cx + rng.uniform(-0.2, 0.2), cy + rng.uniform(-0.2, 0.2), rng.uniform(-0.5, 0.5), 1.0};
+                for (int t = 0; t < 4; ++t) {
+                    const auto base = static_cast<std::uint32_t>(s.vertices.size());
+                    for (int k = 0; k < 3; ++k) s.vertices.push_back(vertex_near(rng, c, 0.01, false));
+                    idx.insert(idx.end(), {base, base + 1, base + 2});
+                }
+                s.item_indices.push_back(std::move(idx));
+                s.item_object.push_back(static_cast<std::uint32_t>(o));
+            }
+        }
+        return s;
+    };
+    const Scene crowded = make(150, 2, 0.1), apart = make(2, 150, 0.0);
+    for (const int threads : {1, 2}) {
+        CAPTURE(threads);
+        raster::VisibilityPass pass;
+        for (int call = 0; call < 40; ++call) {
+            auto r = pass.run(32, 32, DepthFormat::D24, items_of(crowded), threads);
+            REQUIRE(r.ok());
+        }
+        auto r = pass.run(32, 32, DepthFormat::D24, items_of(apart), threads);
+        REQUIRE(r.ok());
+        CHECK(pass.last_spared_triangles() == 1200);
+        CHECK(r.value() == recorded(apart, 32, 32, DepthFormat::D24, 1, true));
+    }
+}
+
 TEST_CASE("The fused visibility pass: items that touch only at a pixel border are not alone") {
     // Exact bounds cover closed pixel squares, so two triangles meeting on the line between two
     // pixel columns (window X = 16 at clip x = 0 on 32 pixels) share pixels 15 and 16. The far one
