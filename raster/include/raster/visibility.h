@@ -65,8 +65,8 @@ class VisibilityPass {
     // alone in the view (no other object's triangle reaches a pixel near theirs, and none reaches
     // the far plane), whose answer is 0 without drawing (visibility.cpp, State::alone). Work only:
     // the answers are the same whether or not an item is found alone. The pre-pass that finds them
-    // runs while it pays (its last run on calls of this shape, item and triangle counts, spared 30%
-    // or more of their triangles), and now and then otherwise; 0 when it did not run.
+    // runs while it pays (its last run on calls of this shape, object, item and triangle counts,
+    // spared 30% or more of their triangles), and now and then otherwise; 0 when it did not run.
     [[nodiscard]] std::uint64_t last_spared_triangles() const;
 
    private:
