@@ -207,16 +207,10 @@ void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const
     t.draw = draw;
 
     // Closed square [px, px + 1] meets [lo, hi] iff ceil(lo) - 1 <= px <= floor(hi).
-    const double bx0 = exact_ceil(minx - t.margin_xy) - 1.0, bx1 = exact_floor(maxx + t.margin_xy);
-    const double by0 = exact_ceil(miny - t.margin_xy) - 1.0, by1 = exact_floor(maxy + t.margin_xy);
-    const double w1 = static_cast<double>(params.target_width - 1),
-                 h1 = static_cast<double>(params.target_height - 1);
-    if (bx1 < 0.0 || by1 < 0.0 || bx0 > w1 || by0 > h1) return;
-    t.x0 = static_cast<int>(std::max(bx0, 0.0));
-    t.y0 = static_cast<int>(std::max(by0, 0.0));
-    t.x1 = static_cast<int>(std::min(bx1, w1));
-    t.y1 = static_cast<int>(std::min(by1, h1));
-    t.single = bx0 == bx1 && by0 == by1;
+    const GrownBox box = grown_box(minx, maxx, miny, maxy, t.margin_xy);
+    if (box.outside(params.target_width, params.target_height)) return;
+    box.cut(params.target_width, params.target_height, t.x0, t.y0, t.x1, t.y1);
+    t.single = box.bx0 == box.bx1 && box.by0 == box.by1;
     BoundsPlane plane;
     if (!t.single) classify_bounds_triangle(t, win, n, minx, maxx, miny, maxy, plane);
     t.first = static_cast<std::uint32_t>(pool.size());

@@ -46,6 +46,27 @@ inline double exact_ceil(double x) {
     return t < x ? t + 1.0 : t;
 }
 
+// The pixels whose closed square [px, px + 1] grown by m meets [x0, x1] x [y0, y1]: ceil(lo - m) - 1
+// <= px <= floor(hi + m), before cutting to a target (setup_bounds_triangle's pixel box, and
+// bounds_reach's from the same operations).
+struct GrownBox {
+    double bx0, by0, bx1, by1;
+    // No pixel of a width x height target.
+    [[nodiscard]] bool outside(int width, int height) const {
+        return bx1 < 0.0 || by1 < 0.0 || bx0 > static_cast<double>(width - 1) || by0 > static_cast<double>(height - 1);
+    }
+    // Cut to the target (not outside it): inclusive pixels.
+    void cut(int width, int height, int& x0, int& y0, int& x1, int& y1) const {
+        x0 = static_cast<int>(std::max(bx0, 0.0));
+        y0 = static_cast<int>(std::max(by0, 0.0));
+        x1 = static_cast<int>(std::min(bx1, static_cast<double>(width - 1)));
+        y1 = static_cast<int>(std::min(by1, static_cast<double>(height - 1)));
+    }
+};
+inline GrownBox grown_box(double x0, double x1, double y0, double y1, double m) {
+    return {exact_ceil(x0 - m) - 1.0, exact_ceil(y0 - m) - 1.0, exact_floor(x1 + m), exact_floor(y1 + m)};
+}
+
 // One vertex of a clipped polygon in window coordinates.
 struct BoundsVertex {
     double x, y, z;
@@ -211,7 +232,6 @@ BoundsReach bounds_reach(const FrontEndParams& params, const MeshViewD& mesh, De
     const double hh = static_cast<double>(vp.height) * 0.5;
     const double tx = static_cast<double>(vp.x) + hw;
     const double ty = static_cast<double>(vp.y) + hh;
-    const double w1 = static_cast<double>(params.target_width - 1), h1 = static_cast<double>(params.target_height - 1);
     r.empty = false;
     if (absmax > 2.0) {  // large magnitudes: clipping's rounding scales with M; the whole target
         r.x0 = 0, r.y0 = 0, r.x1 = params.target_width - 1, r.y1 = params.target_height - 1;
@@ -238,13 +258,9 @@ BoundsReach bounds_reach(const FrontEndParams& params, const MeshViewD& mesh, De
     }
     // The box of window extremes [x0, x1] x [y0, y1] grown by m, in the target; false when outside.
     const auto pixel_box = [&](double x0, double x1, double y0, double y1, int* b) {
-        const double bx0 = exact_ceil(x0 - m) - 1.0, bx1 = exact_floor(x1 + m);
-        const double by0 = exact_ceil(y0 - m) - 1.0, by1 = exact_floor(y1 + m);
-        if (bx1 < 0.0 || by1 < 0.0 || bx0 > w1 || by0 > h1) return false;
-        b[0] = static_cast<int>(std::max(bx0, 0.0));
-        b[1] = static_cast<int>(std::max(by0, 0.0));
-        b[2] = static_cast<int>(std::min(bx1, w1));
-        b[3] = static_cast<int>(std::min(by1, h1));
+        const GrownBox g = grown_box(x0, x1, y0, y1, m);
+        if (g.outside(params.target_width, params.target_height)) return false;
+        g.cut(params.target_width, params.target_height, b[0], b[1], b[2], b[3]);
         return true;
     };
     int all[4];

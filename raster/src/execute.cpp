@@ -193,42 +193,26 @@ struct DrawReach {
 constexpr std::size_t kObservePiece = 1024;
 struct ObservedUnit {
     std::uint32_t cmd;
-    std::size_t k0, k1;  // its part of the command's index list
+    std::uint32_t query;  // the query active at it, or kNoQuery
+    std::size_t k0, k1;   // its part of the command's index list
 };
-struct ObservedScratch {
-    std::vector<ObservedUnit> units;   // per batch, in command order
-    std::vector<DrawReach> reach;      // per unit
-    std::vector<std::uint32_t> query;  // per unit: the active query, or kNoQuery
+// One batch's units in command order, and which of them run.
+struct ObservedBatch {
+    std::vector<ObservedUnit> units;
+    std::vector<std::uint8_t> keep;
 };
-
-// Whether draw command c is observed in pieces.
-bool observed_in_pieces(const Command& c) {
-    return c.state.mode == RasterMode::GLExact && !c.double_input && c.mesh.indices.size() > 3 * 3 * kObservePiece;
-}
 
 // Flags over the cells, with a coarse level (8 x 8 cells) so that a large box costs a few coarse
 // cells: `fine` per cell, and per coarse cell `some` (a fine flag or a large box is inside) and
 // `all` (a large box reached it: every cell counts as flagged). Both answers are supersets, which
 // can only keep more draws.
-// The cells: squares of 2^shift pixels, at most 128 a side; cx x cy of them.
-struct CellGrid {
-    int shift = 0;
-    std::size_t cx = 0, cy = 0;
-    explicit CellGrid(const DepthTarget& target) {
-        while ((std::max(target.width(), target.height()) + (1 << shift) - 1) >> shift > 128) ++shift;
-        cx = static_cast<std::size_t>(((target.width() - 1) >> shift) + 1);
-        cy = static_cast<std::size_t>(((target.height() - 1) >> shift) + 1);
-    }
-};
-
 class CellFlags {
    public:
-    void reset(const CellGrid& g) { reset(g.cx, g.cy); }
-    void reset(std::size_t cx, std::size_t cy) {
-        cx_ = cx;
-        ccx_ = (cx + 7) / 8;
-        fine_.assign(cx * cy, 0);
-        some_.assign(ccx_ * ((cy + 7) / 8), 0);
+    void reset(const detail::CellGrid& g) {
+        cx_ = static_cast<std::size_t>(g.x);
+        ccx_ = (cx_ + 7) / 8;
+        fine_.assign(g.count(), 0);
+        some_.assign(ccx_ * ((static_cast<std::size_t>(g.y) + 7) / 8), 0);
         all_.assign(some_.size(), 0);
     }
     [[nodiscard]] bool any(const DrawReach& r) const {
@@ -268,9 +252,8 @@ class CellFlags {
 DrawReach draw_reach(const DepthTarget& target, RasterRules rules, const Command& c, std::size_t k0, std::size_t k1,
                      int shift) {
     DrawReach r;
-    const int cw = ((target.width() - 1) >> shift), ch = ((target.height() - 1) >> shift);
     const auto whole = [&] {
-        r.x0 = 0, r.y0 = 0, r.x1 = cw, r.y1 = ch;
+        r.x0 = 0, r.y0 = 0, r.x1 = (target.width() - 1) >> shift, r.y1 = (target.height() - 1) >> shift;
         r.depth_known = false;
         return r;
     };
@@ -303,15 +286,15 @@ DrawReach draw_reach(const DepthTarget& target, RasterRules rules, const Command
     return r;
 }
 
-// keep[i] = whether command i (a draw) must run; see above. The reaches are found in parallel
-// chunks of commands (each its own entries); the two sweeps are serial but touch cells only.
-// `read` holds the cells that queries after the batch may read (reset by the caller: empty when
-// the next batch starts on a cleared target) and is left holding the batch's own as well.
-void observed_draws(const DepthTarget& target, const CellGrid& grid, const CommandBatch& batch, bool cleared_to_one,
-                    int threads, ObservedScratch& s, CellFlags& read, std::vector<std::uint8_t>& keep) {
+// The batch's units into ob.units and whether each must run into ob.keep; see above. The reaches
+// are found in parallel chunks of units; the two sweeps are serial but touch cells only. `read`
+// holds the cells that queries after the batch may read (reset by the caller: empty when the next
+// batch starts on a cleared target) and is left holding the batch's own as well.
+void observed_draws(const DepthTarget& target, const detail::CellGrid& grid, const CommandBatch& batch,
+                    bool cleared_to_one, int threads, std::vector<DrawReach>& reach, CellFlags& read,
+                    ObservedBatch& ob) {
     const auto& cmds = batch.commands();
-    s.units.clear();
-    s.query.clear();
+    ob.units.clear();
     std::uint32_t active = kNoQuery;
     for (std::size_t i = 0; i < cmds.size(); ++i) {
         const Command& c = cmds[i];
@@ -321,44 +304,43 @@ void observed_draws(const DepthTarget& target, const CellGrid& grid, const Comma
             active = kNoQuery;
         } else {
             const std::size_t n = c.double_input ? c.mesh_d.indices.size() : c.mesh.indices.size();
-            const std::size_t step = observed_in_pieces(c) ? 3 * kObservePiece : std::max<std::size_t>(n, 1);
-            for (std::size_t k = 0; k == 0 || k < n; k += step) {
-                s.units.push_back({static_cast<std::uint32_t>(i), k, std::min(n, k + step)});
-                s.query.push_back(active);
-            }
+            const bool pieces = c.state.mode == RasterMode::GLExact && !c.double_input && n > 3 * 3 * kObservePiece;
+            const std::size_t step = pieces ? 3 * kObservePiece : std::max<std::size_t>(n, 1);
+            for (std::size_t k = 0; k == 0 || k < n; k += step)
+                ob.units.push_back({static_cast<std::uint32_t>(i), active, k, std::min(n, k + step)});
         }
     }
-    const std::size_t n_units = s.units.size();
-    s.reach.resize(n_units);
-    keep.assign(n_units, 0);
+    const std::size_t n_units = ob.units.size();
+    reach.resize(n_units);
+    ob.keep.assign(n_units, 0);
     constexpr std::size_t kReachChunk = 256;
     detail::parallel_for(threads, (n_units + kReachChunk - 1) / kReachChunk, [&](std::size_t chunk) {
         const std::size_t end = std::min(n_units, (chunk + 1) * kReachChunk);
         for (std::size_t u = chunk * kReachChunk; u < end; ++u)
-            s.reach[u] = draw_reach(target, batch.rules(), cmds[s.units[u].cmd], s.units[u].k0, s.units[u].k1, grid.shift);
+            reach[u] = draw_reach(target, batch.rules(), cmds[ob.units[u].cmd], ob.units[u].k0, ob.units[u].k1, grid.shift);
     });
-    thread_local CellFlags written;
     for (std::size_t u = n_units; u-- > 0;) {  // backward: the writes a later query may read
-        const DrawReach& r = s.reach[u];
+        const DrawReach& r = reach[u];
         if (r.x0 > r.x1 || r.y0 > r.y1) continue;  // no pixel
-        const bool counted = s.query[u] != kNoQuery;
-        keep[u] = counted || (cmds[s.units[u].cmd].state.depth_write && read.any(r)) ? 1 : 0;
+        const bool counted = ob.units[u].query != kNoQuery;
+        ob.keep[u] = counted || (cmds[ob.units[u].cmd].state.depth_write && read.any(r)) ? 1 : 0;
         if (counted) read.mark(r);
     }
     if (!cleared_to_one) return;
+    thread_local CellFlags written;
     written.reset(grid);
     constexpr double kBelowClear = 1.0 - 0x1p-10;
     for (std::size_t u = 0; u < n_units; ++u) {  // forward: queries that meet only the clear value
-        if (!keep[u]) continue;
-        const Command& c = cmds[s.units[u].cmd];
-        const DrawReach& r = s.reach[u];
-        if (s.query[u] != kNoQuery && !c.state.depth_write) {
+        if (!ob.keep[u]) continue;
+        const Command& c = cmds[ob.units[u].cmd];
+        const DrawReach& r = reach[u];
+        if (ob.units[u].query != kNoQuery && !c.state.depth_write) {
             const DepthFunc f = c.state.depth_func;
             const bool fails_on_clear =
                 f == DepthFunc::Never || ((f == DepthFunc::GEqual || f == DepthFunc::Greater || f == DepthFunc::Equal) &&
                                           r.depth_known && r.zmax <= kBelowClear);
             if (fails_on_clear && (f == DepthFunc::Never || !written.any(r))) {
-                keep[u] = 0;
+                ob.keep[u] = 0;
                 continue;
             }
         }
@@ -368,20 +350,20 @@ void observed_draws(const DepthTarget& target, const CellGrid& grid, const Comma
 
 void draws(std::span<const CommandBatch* const> batches, int threads, Draws& d, const DepthTarget& target,
            const ExecuteOptions& options) {
-    thread_local ObservedScratch observed;
+    thread_local std::vector<DrawReach> reach;
     thread_local CellFlags read;
-    thread_local std::vector<std::vector<std::uint8_t>> keeps;
-    const bool cleared_to_one = options.clear_depth && *options.clear_depth >= 1.0;
+    thread_local std::vector<ObservedBatch> observed;
     if (options.queries_only) {
         // Each batch on a cleared target (clear_depth): its queries read only its own writes.
         // Otherwise a batch starts on the one before's depth, so a write is kept when a query of
         // its own or of any later batch may read it: the batches from the last, the cells carried.
-        if (keeps.size() < batches.size()) keeps.resize(batches.size());
-        const CellGrid grid(target);
+        if (observed.size() < batches.size()) observed.resize(batches.size());
+        const detail::CellGrid grid = detail::CellGrid::of(target.width(), target.height());
+        const bool cleared_to_one = options.clear_depth && *options.clear_depth >= 1.0;
         read.reset(grid);
         for (std::size_t k = batches.size(); k-- > 0;) {
             if (options.clear_depth) read.reset(grid);
-            observed_draws(target, grid, *batches[k], cleared_to_one, threads, observed, read, keeps[k]);
+            observed_draws(target, grid, *batches[k], cleared_to_one, threads, reach, read, observed[k]);
         }
     }
     d.cmd.clear();
@@ -391,40 +373,40 @@ void draws(std::span<const CommandBatch* const> batches, int threads, Draws& d, 
     d.k0.clear();
     d.k1.clear();
     d.first.clear();
+    // Part [u0, u1) of command i's index list as one entry, or with several threads a big GL-exact
+    // part as pieces of kFrontEndPiece triangles.
+    const auto add = [&](const CommandBatch& batch, std::size_t i, std::uint32_t query, std::size_t u0, std::size_t u1) {
+        const Command& c = batch.commands()[i];
+        const bool split = threads > 1 && c.state.mode == RasterMode::GLExact && !c.double_input &&
+                           u1 - u0 > 3 * kFrontEndPiece;
+        for (std::size_t k = u0; k == u0 || (split && k < u1); k += 3 * kFrontEndPiece) {
+            d.cmd.push_back(&c);
+            d.index.push_back(static_cast<std::uint32_t>(i));
+            d.query.push_back(query);
+            d.rules.push_back(batch.rules());
+            d.k0.push_back(k);
+            d.k1.push_back(split ? std::min(u1, k + 3 * kFrontEndPiece) : u1);
+        }
+    };
     for (std::size_t b = 0; b < batches.size(); ++b) {
-        const CommandBatch* batch = batches[b];
+        const CommandBatch& batch = *batches[b];
         d.first.push_back(d.cmd.size());
-        const auto& cmds = batch->commands();
-        const std::uint8_t* keep = options.queries_only ? keeps[b].data() : nullptr;
-        std::size_t unit = 0;  // with queries_only: the next unit of observed_draws, in the same order
+        if (options.queries_only) {  // the kept units (observed_draws)
+            const ObservedBatch& ob = observed[b];
+            for (std::size_t u = 0; u < ob.units.size(); ++u)
+                if (ob.keep[u]) add(batch, ob.units[u].cmd, ob.units[u].query, ob.units[u].k0, ob.units[u].k1);
+            continue;
+        }
+        const auto& cmds = batch.commands();
         std::uint32_t active = kNoQuery;
         for (std::size_t i = 0; i < cmds.size(); ++i) {
             if (cmds[i].kind == Command::Kind::BeginQuery) {
                 active = cmds[i].query;
-                continue;
-            }
-            if (cmds[i].kind == Command::Kind::EndQuery) {
+            } else if (cmds[i].kind == Command::Kind::EndQuery) {
                 active = kNoQuery;
-                continue;
-            }
-            const Command& c = cmds[i];
-            const std::size_t n = c.double_input ? c.mesh_d.indices.size() : c.mesh.indices.size();
-            // The parts run: the whole list, or with queries_only its kept units (observed_draws).
-            const std::size_t step = keep != nullptr && observed_in_pieces(c) ? 3 * kObservePiece : std::max<std::size_t>(n, 1);
-            for (std::size_t u0 = 0; u0 == 0 || u0 < n; u0 += step) {
-                const std::size_t u1 = std::min(n, u0 + step);
-                if (keep != nullptr && !keep[unit++]) continue;  // no query observes it
-                // With several threads a big GL-exact part runs as pieces of kFrontEndPiece triangles.
-                const bool split = threads > 1 && c.state.mode == RasterMode::GLExact && !c.double_input &&
-                                   u1 - u0 > 3 * kFrontEndPiece;
-                for (std::size_t k = u0; k == u0 || (split && k < u1); k += 3 * kFrontEndPiece) {
-                    d.cmd.push_back(&c);
-                    d.index.push_back(static_cast<std::uint32_t>(i));
-                    d.query.push_back(active);
-                    d.rules.push_back(batch->rules());
-                    d.k0.push_back(k);
-                    d.k1.push_back(split ? std::min(u1, k + 3 * kFrontEndPiece) : u1);
-                }
+            } else {
+                const Command& c = cmds[i];
+                add(batch, i, active, 0, c.double_input ? c.mesh_d.indices.size() : c.mesh.indices.size());
             }
         }
     }

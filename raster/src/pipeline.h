@@ -229,4 +229,21 @@ inline bool rect_outside(const SetupTri& t, int x0, int y0, int x1, int y1) {
     return true;
 }
 
+// Square cells of 2^shift pixels over a width x height target, at most kMaxCells per row and
+// column: the coarse occupancy grids of the fused visibility pass's items-alone pre-pass and of the
+// executor's queries_only (which draws a query may observe).
+struct CellGrid {
+    static constexpr int kMaxCells = 128;
+    int shift = 0;
+    int x = 0, y = 0;  // cells per row and per column
+    static CellGrid of(int width, int height) {
+        CellGrid g;
+        while ((std::max(width, height) + (1 << g.shift) - 1) >> g.shift > kMaxCells) ++g.shift;
+        g.x = (width + (1 << g.shift) - 1) >> g.shift;
+        g.y = (height + (1 << g.shift) - 1) >> g.shift;
+        return g;
+    }
+    [[nodiscard]] std::size_t count() const { return static_cast<std::size_t>(x) * static_cast<std::size_t>(y); }
+};
+
 }  // namespace raster::detail

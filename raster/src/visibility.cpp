@@ -142,23 +142,13 @@ struct TileGrid {
     [[nodiscard]] std::size_t pixels() const { return static_cast<std::size_t>(side) * static_cast<std::size_t>(side); }
 };
 
-// Which objects' items may reach each cell of the target (squares of 2^shift pixels, at most
-// kOccCells per row and column): kOccNone, kOccOne (one object: `obj`) or kOccMany.
-constexpr int kOccCells = 128;
+// Which objects' items may reach each cell of the target (detail::CellGrid): kOccNone, kOccOne (one
+// object: `obj`) or kOccMany.
 constexpr std::uint8_t kOccNone = 0, kOccOne = 1, kOccMany = 2;
-struct OccGrid {
-    int shift, x, y;  // cell side 2^shift pixels; cells per row and per column
-    static OccGrid of(int width, int height) {
-        int shift = 0;
-        while ((std::max(width, height) + (1 << shift) - 1) >> shift > kOccCells) ++shift;
-        return {shift, (width + (1 << shift) - 1) >> shift, (height + (1 << shift) - 1) >> shift};
-    }
-    [[nodiscard]] std::size_t count() const { return static_cast<std::size_t>(x) * static_cast<std::size_t>(y); }
-};
 
 // The cells of the pixel box [x0, x1] x [y0, y1] reached by the object `k`.
 template <class Key>
-void occ_mark(const OccGrid& g, Key* key, std::uint8_t* state, int x0, int y0, int x1, int y1, Key k) {
+void occ_mark(const detail::CellGrid& g, Key* key, std::uint8_t* state, int x0, int y0, int x1, int y1, Key k) {
     for (int cy = y0 >> g.shift; cy <= y1 >> g.shift; ++cy) {
         const std::size_t row = static_cast<std::size_t>(cy) * static_cast<std::size_t>(g.x);
         for (int cx = x0 >> g.shift; cx <= x1 >> g.shift; ++cx) {
@@ -174,7 +164,7 @@ void occ_mark(const OccGrid& g, Key* key, std::uint8_t* state, int x0, int y0, i
 }
 
 // Whether every cell of the pixel box is reached by one key only.
-inline bool occ_one(const OccGrid& g, const std::uint8_t* state, int x0, int y0, int x1, int y1) {
+inline bool occ_one(const detail::CellGrid& g, const std::uint8_t* state, int x0, int y0, int x1, int y1) {
     for (int cy = y0 >> g.shift; cy <= y1 >> g.shift; ++cy) {
         const std::size_t row = static_cast<std::size_t>(cy) * static_cast<std::size_t>(g.x);
         for (int cx = x0 >> g.shift; cx <= x1 >> g.shift; ++cx)
@@ -186,7 +176,7 @@ inline bool occ_one(const OccGrid& g, const std::uint8_t* state, int x0, int y0,
 // Whether an item is alone, from its reach (cells as marked): it reaches nothing, or its one box's
 // cells hold its key only and no fragment of it reaches the clear value. (Items of scattered
 // triangles, several boxes, are always drawn.)
-inline bool occ_alone(const OccGrid& g, const std::uint8_t* state, const detail::BoundsReach& r, std::uint32_t clear) {
+inline bool occ_alone(const detail::CellGrid& g, const std::uint8_t* state, const detail::BoundsReach& r, std::uint32_t clear) {
     if (!r.ok) return false;
     if (r.empty) return true;
     return r.single && r.zq_hi < clear && occ_one(g, state, r.x0, r.y0, r.x1, r.y1);
@@ -279,7 +269,7 @@ struct VisibilityPass::State {
     // Items alone in the view (see alone()): not set up, not drawn.
     std::vector<detail::BoundsReach> reach;                // per item
     std::vector<std::uint8_t> skip;                        // per item
-    std::vector<std::uint32_t> occ_obj;                    // per cell (OccGrid)
+    std::vector<std::uint32_t> occ_obj;                    // per cell (detail::CellGrid)
     std::vector<std::uint8_t> occ_state;                   // per cell: kOccNone / kOccOne / kOccMany
     std::vector<std::vector<std::uint32_t>> part_occ_obj;  // split_pass: per part, its own cells
     std::vector<std::vector<std::uint8_t>> part_occ_state;
@@ -288,11 +278,11 @@ struct VisibilityPass::State {
     void alone_record(std::span<const VisibilityItem> items, const AloneGuard::Call& call);
     // Items [first, last): reach[i], and their reach marked into the cells obj / state.
     void mark(const detail::FrontEndParams& params, std::span<const VisibilityItem> items, DepthFormat format,
-              const OccGrid& g, std::size_t first, std::size_t last, std::uint32_t* obj, std::uint8_t* state);
+              const detail::CellGrid& g, std::size_t first, std::size_t last, std::uint32_t* obj, std::uint8_t* state);
     void mark_parts(const detail::FrontEndParams& params, std::span<const VisibilityItem> items, DepthFormat format,
-                    const OccGrid& g, int threads, std::size_t n_parts);
+                    const detail::CellGrid& g, int threads, std::size_t n_parts);
     // skip[i] for item i against the merged cells occ_obj / occ_state.
-    void alone(const OccGrid& g, DepthFormat format, std::size_t i);
+    void alone(const detail::CellGrid& g, DepthFormat format, std::size_t i);
     // One triangle's fragments into the minima of a tile at (x0, y0)..(x1, y1) of `side` pixels a
     // row; with `keep`, each fragment's zmax goes to `out` for the query test.
     __attribute__((always_inline)) void draw(std::span<const VisibilityItem> items, Ref r, bool keep, int x0, int y0,
@@ -366,7 +356,7 @@ bool VisibilityPass::State::front_end(int width, int height, DepthFormat format,
                                       int threads, bool use_alone) {
     reserve_items(items.size());
     const detail::FrontEndParams params = front_end_params(width, height);
-    const OccGrid g = OccGrid::of(width, height);
+    const detail::CellGrid g = detail::CellGrid::of(width, height);
     if (use_alone) {
         occ_obj.resize(g.count());
         occ_state.assign(g.count(), kOccNone);
@@ -411,7 +401,7 @@ void VisibilityPass::State::depth_bounds(DepthFormat format, std::size_t n_items
 // items drawn, never fewer than needed). An item that fails an input check is never skipped, so the
 // front end still finds and reports it.
 void VisibilityPass::State::mark(const detail::FrontEndParams& params, std::span<const VisibilityItem> items,
-                                 DepthFormat format, const OccGrid& g, std::size_t first, std::size_t last,
+                                 DepthFormat format, const detail::CellGrid& g, std::size_t first, std::size_t last,
                                  std::uint32_t* obj, std::uint8_t* state) {
     for (std::size_t i = first; i < last; ++i) {
         const std::uint32_t o = items[i].object;
@@ -421,7 +411,7 @@ void VisibilityPass::State::mark(const detail::FrontEndParams& params, std::span
     }
 }
 
-void VisibilityPass::State::alone(const OccGrid& g, DepthFormat format, std::size_t i) {
+void VisibilityPass::State::alone(const detail::CellGrid& g, DepthFormat format, std::size_t i) {
     skip[i] = occ_alone(g, occ_state.data(), reach[i], DepthTarget::encode_clear(1.0, format)) ? 1 : 0;
 }
 
@@ -584,7 +574,7 @@ void VisibilityPass::State::test_fragments(std::span<const VisibilityItem> items
 // split_pass's marking: each part's reach into its own cells, in parallel, merged in part order
 // (kOccMany where two parts hold different objects): the same cells as one marking of every item.
 void VisibilityPass::State::mark_parts(const detail::FrontEndParams& params, std::span<const VisibilityItem> items,
-                                       DepthFormat format, const OccGrid& g, int threads, std::size_t n_parts) {
+                                       DepthFormat format, const detail::CellGrid& g, int threads, std::size_t n_parts) {
     if (part_occ_obj.size() < n_parts) {
         part_occ_obj.resize(n_parts);
         part_occ_state.resize(n_parts);
@@ -654,7 +644,7 @@ int VisibilityPass::State::split_pass(std::span<const VisibilityItem> items, con
     }
     part_done.assign(n_parts, 0);
     const detail::FrontEndParams params = front_end_params(width, height);
-    const OccGrid g = OccGrid::of(width, height);
+    const detail::CellGrid g = detail::CellGrid::of(width, height);
     if (use_alone) mark_parts(params, items, format, g, threads, n_parts);
     detail::parallel_for(threads, n_parts, [&](std::size_t part) {
         std::uint64_t part_area = 0, part_count = 0;

@@ -796,6 +796,33 @@ TEST_CASE("execute_sequence == execute per batch with the clear between, and an 
     CHECK(outer.value()[1] == want.value());
 }
 
+// The sequence with queries_only on 1, 2 and 3 threads against `want`, full execution's results
+// (its final target `want_t`): `calls` calls on one fresh target each, with clear_depth = 1 when
+// `cleared` and then written_tiles kept across the calls when `tiles`, as the emulator device runs
+// view after view. Counts the runs and those whose final depth differs from full execution's.
+namespace {
+void check_queries_only(const std::vector<const raster::CommandBatch*>& ptrs, DepthFormat f, bool cleared, bool tiles,
+                        int calls, const std::vector<raster::QueryResults>& want, const raster::DepthTarget& want_t,
+                        int& runs, int& differs) {
+    for (const int threads : {1, 2, 3}) {
+        CAPTURE(threads);
+        auto t = raster::DepthTarget::create(want_t.width(), want_t.height(), f).value();
+        std::vector<std::uint8_t> written;
+        raster::ExecuteOptions o{threads, true};
+        o.queries_only = true;
+        if (cleared) o.clear_depth = 1.0;
+        if (tiles) o.written_tiles = &written;
+        for (int call = 0; call < calls; ++call) {
+            const auto got = raster::execute_sequence(t, ptrs, o);
+            REQUIRE(got.ok());
+            CHECK(got.value() == want);
+        }
+        ++runs;
+        if (!std::equal(t.values().begin(), t.values().end(), want_t.values().begin(), want_t.values().end())) ++differs;
+    }
+}
+}  // namespace
+
 // ExecuteOptions::queries_only (execute.cpp, observed_draws): draws that no query can observe are
 // skipped, with the same query results. Random sequences of CULLIDE-like passes over clusters of
 // items in separate places (so that most draws are unobserved) and some overlapping, plus draws of
@@ -885,31 +912,12 @@ TEST_CASE("queries_only skips unobserved draws with the same query results") {
                 if (cleared) full.clear_depth = 1.0;
                 const auto want = raster::execute_sequence(want_t, ptrs, full);
                 REQUIRE(want.ok());
-                for (const int threads : {1, 2, 3}) {
-                    CAPTURE(rep);
-                    CAPTURE(static_cast<int>(f));
-                    CAPTURE(cleared);
-                    CAPTURE(threads);
-                    auto t = raster::DepthTarget::create(w, h, f).value();
-                    std::vector<std::uint8_t> written;
-                    raster::ExecuteOptions o{threads, true};
-                    o.queries_only = true;
-                    if (cleared) {
-                        o.clear_depth = 1.0;
-                        o.written_tiles = &written;
-                    }
-                    // Cleared: twice on one target, as the emulator device runs view after view
-                    // (the target's content after a call is unspecified, so without clear_depth a
-                    // second call would start from it).
-                    for (int call = 0; call < (cleared ? 2 : 1); ++call) {
-                        const auto got = raster::execute_sequence(t, ptrs, o);
-                        REQUIRE(got.ok());
-                        CHECK(got.value() == want.value());
-                    }
-                    ++runs;
-                    if (!std::equal(t.values().begin(), t.values().end(), want_t.values().begin(), want_t.values().end()))
-                        ++differs;
-                }
+                CAPTURE(rep);
+                CAPTURE(static_cast<int>(f));
+                CAPTURE(cleared);
+                // Cleared: twice on one target with written_tiles (the target's content after a call
+                // is unspecified, so without clear_depth a second call would start from it).
+                check_queries_only(ptrs, f, cleared, cleared, cleared ? 2 : 1, want.value(), want_t, runs, differs);
             }
         }
     }
@@ -976,20 +984,8 @@ TEST_CASE("queries_only: the pieces of a big draw far from every other draw are 
             full.clear_depth = 1.0;
             const auto want = raster::execute_sequence(want_t, ptrs, full);
             REQUIRE(want.ok());
-            for (const int threads : {1, 2, 3}) {
-                CAPTURE(rep);
-                CAPTURE(threads);
-                auto t = raster::DepthTarget::create(256, 160, f).value();
-                raster::ExecuteOptions o = full;
-                o.threads = threads;
-                o.queries_only = true;
-                const auto got = raster::execute_sequence(t, ptrs, o);
-                REQUIRE(got.ok());
-                CHECK(got.value() == want.value());
-                ++runs;
-                if (!std::equal(t.values().begin(), t.values().end(), want_t.values().begin(), want_t.values().end()))
-                    ++differs;
-            }
+            CAPTURE(rep);
+            check_queries_only(ptrs, f, true, false, 1, want.value(), want_t, runs, differs);
         }
     }
     CHECK(differs == runs);
