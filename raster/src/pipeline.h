@@ -31,6 +31,13 @@ inline constexpr bool kLpPositiveIsCcw = false;  // llvmpipe's positive area is 
 // after the half-pixel offset): e_i = c[i] - dcdx[i] * 256 * px + dcdy[i] * 256 * py; the pixel is
 // covered when all three are > 0 (the fill-rule bias is folded into c).
 struct SetupTri {
+    // Setup writes every field of a record in place (triangle_setup.cpp): built in a local and
+    // pushed, its narrow field stores were read back by the copy's 16-byte loads, which stalled
+    // store forwarding three times per triangle (perf, raster_bench SmallTris); emplace_back()
+    // would zero the 112 bytes first. SetupTri() stays the trivial default.
+    struct Uninitialized {};
+    SetupTri() = default;
+    explicit SetupTri(Uninitialized) {}  // NOLINT: every field is set by its caller
     std::int64_t c[3];
     std::int64_t dcdx[3];
     std::int64_t dcdy[3];

@@ -194,10 +194,11 @@ inline void setup_snapped(const FrontEndParams& p, int64_t* x, int64_t* y, const
     bx1 = std::min<int64_t>(bx1, p.target_width - 1);
     by1 = std::min<int64_t>(by1, p.target_height - 1);
     if (bx0 > bx1 || by0 > by1) return;
-    // Every field is written below, so the record starts uninitialized: emplace_back() zeroed its
-    // 112 bytes first (rep stos, out of line: 14.6% of SmallTris' samples at 256^2), and a zeroed
-    // local copied into the list cost more still (session 9).
-    SetupTri t;
+    // Every field is written below, so the record starts uninitialized, in the list itself:
+    // emplace_back() zeroed its 112 bytes first (rep stos, out of line: 14.6% of SmallTris' samples
+    // at 256^2), a zeroed local copied into the list cost more still (session 9), and an
+    // uninitialized local's copy stalled on store forwarding (pipeline.h, SetupTri).
+    SetupTri& t = out.emplace_back(SetupTri::Uninitialized{});
     t.x0 = static_cast<int>(bx0);
     t.y0 = static_cast<int>(by0);
     t.x1 = static_cast<int>(bx1);
@@ -233,7 +234,6 @@ inline void setup_snapped(const FrontEndParams& p, int64_t* x, int64_t* y, const
         const int64_t span_x = maxx - minx, span_y = maxy - miny;
         t.fits32 = span_y * (span_x + 2048) + span_x * (span_y + 256) + 1 < (int64_t{1} << 31);
     }
-    out.push_back(t);
 }
 
 // llvmpipe's setup of one (post-clip) triangle in window coordinates.
