@@ -5,7 +5,8 @@
 //
 // From the input it builds a command batch for a target of 1..160 x 1..160 pixels (so up to 3 x 3
 // tiles of 64), any depth format and clear value: up to 12 draws and queries (both kinds, sometimes
-// left unbalanced), each draw 1..4 triangles of float clip coordinates (pixel-centre lattice values,
+// left unbalanced), each draw 1..4 triangles (now and then repeated, shifted, up to 9..16, so that
+// setup runs 8 triangles at once) of float clip coordinates (pixel-centre lattice values,
 // fractions, 1/256 snapping ties, huge, tiny, non-finite and raw float bits; w = 1 mostly, else
 // random, zero or negative, so the near/far and side clipping runs), every DepthFunc, depth mask on or
 // off, culling and facing, an optional viewport (also partly outside the target), and now and then an
@@ -76,13 +77,13 @@ class Reader {
 };
 
 struct Stats {
-    unsigned long long runs = 0, rejected = 0, draws = 0, queries = 0, samples = 0, pixels_written = 0;
+    unsigned long long runs = 0, rejected = 0, draws = 0, queries = 0, samples = 0, pixels_written = 0, grouped = 0;
     ~Stats() {
         if (std::getenv("RASTER_FUZZ_STATS") != nullptr)
             std::fprintf(stderr,
                          "raster_gl_exact_fuzz: %llu runs, %llu rejected, %llu draws, %llu queries, %llu samples "
-                         "passed, %llu pixels written\n",
-                         runs, rejected, draws, queries, samples, pixels_written);
+                         "passed, %llu pixels written, %llu draws of 9-16 triangles\n",
+                         runs, rejected, draws, queries, samples, pixels_written, grouped);
     }
 };
 Stats g_stats;
@@ -156,6 +157,30 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             if (ib == 255) index = 1000;
             else if ((ib & 7U) == 1) index = static_cast<std::uint32_t>(k - k % 3 + (2 - k % 3));
             idx.push_back(index);
+        }
+        // Now and then the draw's triangles again, shifted by whole pixels and with every other
+        // copy's winding reversed, up to 9-16 triangles: the tiled path then sets up groups of 8
+        // triangles at once (setup_avx2.cpp), which draws of 1-4 triangles never reach.
+        if ((kind & 0xc0U) == 0xc0U) {
+            const std::size_t n0 = idx.size();
+            const float dx = 2.0f / static_cast<float>(w), dy = 2.0f / static_cast<float>(h);
+            for (int copy = 1; idx.size() < 27; ++copy) {
+                for (std::size_t k = 0; k < n0; ++k) {
+                    const std::uint32_t src = idx[k] < v.size() ? idx[k] : 0;
+                    raster::Float4 p = v[src];
+                    p.x += static_cast<float>(copy) * dx;
+                    p.y -= static_cast<float>(copy % 3) * dy;
+                    v.push_back(p);
+                }
+                const auto base = static_cast<std::uint32_t>(v.size() - n0);
+                for (std::size_t k = 0; k < n0; k += 3) {
+                    const bool flip = copy % 2 == 1;
+                    idx.push_back(base + static_cast<std::uint32_t>(k));
+                    idx.push_back(base + static_cast<std::uint32_t>(flip ? k + 2 : k + 1));
+                    idx.push_back(base + static_cast<std::uint32_t>(flip ? k + 1 : k + 2));
+                }
+            }
+            ++g_stats.grouped;
         }
         raster::DrawState s;
         const std::uint8_t sb = in.byte();

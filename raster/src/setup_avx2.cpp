@@ -1,5 +1,6 @@
-// setup_avx2.cpp: the float part of GL-exact triangle setup for 8 triangles at once (AVX2 + FMA),
-// for the triangles that need no clipping. CMake compiles this file alone with -mavx2 -mfma
+// setup_avx2.cpp: GL-exact triangle setup for 8 triangles at once (AVX2 + FMA), for the triangles
+// that need no clipping: the float part (viewport, snap, depth planes) and, since session 15, the
+// integer part (area, culling, the orientation swap, box, edge functions: setup_ints8_avx2). CMake compiles this file alone with -mavx2 -mfma
 // -ffp-contract=off (x86-64 GCC/Clang, RASTER_KERNEL_AVX2=1); triangle_setup.cpp calls it only when
 // kernel_avx2_available() says so. Elsewhere it builds to a stub.
 //
@@ -14,6 +15,8 @@
 // from fusing the others, as the scalar code is never fused on x86-64. The snap to 16.8 is cvtps2dq
 // (the scalar code's cvtss2si: the same MXCSR rounding) behind the same range test. So each lane's
 // values are the scalar code's bits; tests/raster/simd_test.cpp compares whole SetupTri lists.
+// The integer part is exact integer arithmetic (32-bit lanes, 64-bit products), so it is the same
+// values whatever the instruction order.
 #include "setup_simd.h"
 
 #if defined(RASTER_KERNEL_AVX2)
@@ -84,6 +87,112 @@ void setup_lanes8_avx2(SetupLanes8& io, bool provoking_first) {
     _mm256_storeu_ps(io.z0[1], swapped.z0);
     _mm256_storeu_ps(io.dzdx[1], swapped.dzdx);
     _mm256_storeu_ps(io.dzdy[1], swapped.dzdy);
+}
+
+namespace {
+
+// Bit t of `bits` as lane t's all-ones / zero 32-bit mask.
+__m256i lane_mask(std::uint32_t bits) {
+    const __m256i b = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    return _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(static_cast<int>(bits)), b), b);
+}
+
+// The 64-bit products a * b of 8 signed 32-bit lanes, as the even lanes (0, 2, 4, 6) and the odd
+// ones (1, 3, 5, 7): vpmuldq multiplies the low 32 bits of each 64-bit lane, exactly.
+struct Wide {
+    __m256i even, odd;
+};
+Wide mul_wide(__m256i a, __m256i b) {
+    return {_mm256_mul_epi32(a, b), _mm256_mul_epi32(_mm256_srli_epi64(a, 32), _mm256_srli_epi64(b, 32))};
+}
+Wide sub_wide(Wide a, Wide b) { return {_mm256_sub_epi64(a.even, b.even), _mm256_sub_epi64(a.odd, b.odd)}; }
+
+// Lane order 0..7 again: out[0] = lanes 0-3, out[1] = lanes 4-7.
+void store_wide(const Wide& w, std::int64_t* out) {
+    const __m256i lo = _mm256_unpacklo_epi64(w.even, w.odd);  // 0 1 | 4 5
+    const __m256i hi = _mm256_unpackhi_epi64(w.even, w.odd);  // 2 3 | 6 7
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_permute2x128_si256(lo, hi, 0x20));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + 4), _mm256_permute2x128_si256(lo, hi, 0x31));
+}
+
+// An 8-bit lane mask from 64-bit compare masks of the even and the odd lanes.
+std::uint32_t wide_bits(__m256i even, __m256i odd) {
+    const auto e = static_cast<std::uint32_t>(_mm256_movemask_pd(_mm256_castsi256_pd(even)));
+    const auto o = static_cast<std::uint32_t>(_mm256_movemask_pd(_mm256_castsi256_pd(odd)));
+    std::uint32_t r = 0;
+    for (int k = 0; k < 4; ++k) r |= (((e >> k) & 1u) << (2 * k)) | (((o >> k) & 1u) << (2 * k + 1));
+    return r;
+}
+
+}  // namespace
+
+// setup_snapped (triangle_setup.cpp) for 8 triangles: the same integer operations, each exact, so
+// the same values; the per-lane writer there turns each kept lane into its SetupTri.
+void setup_ints8_avx2(SetupLanes8& io, const SetupIntRules& r) {
+    __m256i x[3], y[3];
+    for (int k = 0; k < 3; ++k) {
+        x[k] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(io.sx[k]));
+        y[k] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(io.sy[k]));
+    }
+    // llvmpipe's area: (x0 - x1) (y2 - y0) - (x2 - x0) (y0 - y1), in 64 bits.
+    const Wide area = sub_wide(mul_wide(_mm256_sub_epi32(x[0], x[1]), _mm256_sub_epi32(y[2], y[0])),
+                               mul_wide(_mm256_sub_epi32(x[2], x[0]), _mm256_sub_epi32(y[0], y[1])));
+    const __m256i zero = _mm256_setzero_si256();
+    const std::uint32_t nonzero = ~wide_bits(_mm256_cmpeq_epi64(area.even, zero), _mm256_cmpeq_epi64(area.odd, zero)) & 0xffu;
+    const std::uint32_t positive = wide_bits(_mm256_cmpgt_epi64(area.even, zero), _mm256_cmpgt_epi64(area.odd, zero));
+    const std::uint32_t gl_ccw = r.lp_positive_is_ccw ? positive : ~positive & 0xffu;
+    const std::uint32_t front = r.front_is_ccw ? gl_ccw : ~gl_ccw & 0xffu;
+    std::uint32_t keep = io.in_range & nonzero;
+    if (r.cull == 2) keep &= front;
+    if (r.cull == 1) keep &= ~front;
+    // The swap of a negative triangle: vertices 0 and 1, or 1 and 2 with the provoking vertex first.
+    const __m256i neg = lane_mask(~positive & 0xffu);
+    const int a = r.provoking_first ? 1 : 0;
+    {
+        const __m256i xa = x[a], xb = x[a + 1], ya = y[a], yb = y[a + 1];
+        x[a] = _mm256_blendv_epi8(xa, xb, neg);
+        x[a + 1] = _mm256_blendv_epi8(xb, xa, neg);
+        y[a] = _mm256_blendv_epi8(ya, yb, neg);
+        y[a + 1] = _mm256_blendv_epi8(yb, ya, neg);
+    }
+    // Bounding box, llvmpipe's rounding, cut to the target.
+    const __m256i one = _mm256_set1_epi32(1);
+    const __m256i adj = _mm256_set1_epi32(r.bottom_edge_rule ? 1 : 0);
+    const __m256i minx = _mm256_min_epi32(_mm256_min_epi32(x[0], x[1]), x[2]);
+    const __m256i maxx = _mm256_max_epi32(_mm256_max_epi32(x[0], x[1]), x[2]);
+    const __m256i miny = _mm256_min_epi32(_mm256_min_epi32(y[0], y[1]), y[2]);
+    const __m256i maxy = _mm256_max_epi32(_mm256_max_epi32(y[0], y[1]), y[2]);
+    const __m256i bx0 = _mm256_max_epi32(_mm256_srai_epi32(minx, 8), zero);
+    const __m256i bx1 = _mm256_min_epi32(_mm256_srai_epi32(_mm256_sub_epi32(maxx, one), 8), _mm256_set1_epi32(r.target_width - 1));
+    const __m256i by0 = _mm256_max_epi32(_mm256_srai_epi32(_mm256_add_epi32(miny, adj), 8), zero);
+    const __m256i by1 = _mm256_min_epi32(_mm256_srai_epi32(_mm256_sub_epi32(_mm256_add_epi32(maxy, adj), one), 8),
+                                         _mm256_set1_epi32(r.target_height - 1));
+    const __m256i empty = _mm256_or_si256(_mm256_cmpgt_epi32(bx0, bx1), _mm256_cmpgt_epi32(by0, by1));
+    keep &= ~static_cast<std::uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(empty))) & 0xffu;
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(io.box[0]), bx0);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(io.box[1]), by0);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(io.box[2]), bx1);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(io.box[3]), by1);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(io.span_x), _mm256_sub_epi32(maxx, minx));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(io.span_y), _mm256_sub_epi32(maxy, miny));
+    // Edges: dcdx = y_i - y_j, dcdy = x_i - x_j, c = dcdx x_i - dcdy y_i, and the fill-rule bias
+    // (dcdx < 0, or dcdx = 0 and the horizontal edge on the convention's side).
+    for (int i = 0; i < 3; ++i) {
+        const int j = i == 2 ? 0 : i + 1;
+        const __m256i dcdx = _mm256_sub_epi32(y[i], y[j]);
+        const __m256i dcdy = _mm256_sub_epi32(x[i], x[j]);
+        store_wide(sub_wide(mul_wide(dcdx, x[i]), mul_wide(dcdy, y[i])), io.c[i]);
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(io.dcdx[i]), dcdx);
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(io.dcdy[i]), dcdy);
+        const __m256i horizontal_in = r.bottom_edge_rule ? _mm256_cmpgt_epi32(zero, dcdy)                          // dcdy < 0
+                                                         : _mm256_xor_si256(_mm256_cmpgt_epi32(zero, dcdy), _mm256_set1_epi32(-1));  // dcdy >= 0
+        const __m256i bias = _mm256_or_si256(_mm256_cmpgt_epi32(zero, dcdx),
+                                             _mm256_and_si256(_mm256_cmpeq_epi32(dcdx, zero), horizontal_in));
+        io.bias_bits[i] = static_cast<std::uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(bias)));
+    }
+    io.keep = keep;
+    io.swapped = ~positive & 0xffu;
+    io.front = front;
 }
 
 namespace {
@@ -163,6 +272,7 @@ void vertices8_avx2(const float* vertices, const float scale[3], const float tra
 #else
 
 void setup_lanes8_avx2(SetupLanes8&, bool) {}
+void setup_ints8_avx2(SetupLanes8&, const SetupIntRules&) {}
 void viewport_lanes8_avx2(SetupLanes8&, const float* const[24], const float[3], const float[3], bool) {}
 void vertices8_avx2(const float*, const float[3], const float[3], bool, float[3][8], std::uint32_t[8]) {}
 

@@ -269,20 +269,43 @@ void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const 
         draw, out);
 }
 
-// Lane t of setup_lanes8: setup_window_triangle's result from the lanes' snap and planes.
+// Lane t of setup_lanes8 and setup_ints8: setup_window_triangle's result, from the lanes' snap,
+// planes and integer setup (setup_avx2.cpp: the same operations, so the same values). Only the
+// record is written here; the integer part ran 8 triangles at a time (its compares and selects
+// per triangle, the orientation swap above all, were most of this function's samples on small
+// random triangles: perf, raster_bench SmallTris).
+void setup_lane(const SetupLanes8& lanes, int t, std::uint32_t draw, std::vector<SetupTri>& out) {
+    if (((lanes.keep >> t) & 1u) == 0) return;
+    SetupTri& r = out.emplace_back(SetupTri::Uninitialized{});
+    for (int e = 0; e < 3; ++e) {
+        r.c[e] = lanes.c[e][t] + static_cast<int64_t>((lanes.bias_bits[e] >> t) & 1u);
+        r.dcdx[e] = lanes.dcdx[e][t];
+        r.dcdy[e] = lanes.dcdy[e][t];
+    }
+    r.x0 = lanes.box[0][t];
+    r.y0 = lanes.box[1][t];
+    r.x1 = lanes.box[2][t];
+    r.y1 = lanes.box[3][t];
+    const int o = static_cast<int>((lanes.swapped >> t) & 1u);
+    r.z0 = lanes.z0[o][t];
+    r.dzdx = lanes.dzdx[o][t];
+    r.dzdy = lanes.dzdy[o][t];
+    r.draw = draw;
+    r.front = ((lanes.front >> t) & 1u) != 0;
+    const int64_t span_x = lanes.span_x[t], span_y = lanes.span_y[t];  // as setup_snapped's fits32
+    r.fits32 = span_y * (span_x + 2048) + span_x * (span_y + 256) + 1 < (int64_t{1} << 31);
+}
+
 template <RasterRules Rules>
-void setup_lane(const FrontEndParams& p, const SetupLanes8& lanes, int t, std::uint32_t draw,
-                std::vector<SetupTri>& out) {
-    if (((lanes.in_range >> t) & 1u) == 0) return;
-    int64_t x[3] = {lanes.sx[0][t], lanes.sx[1][t], lanes.sx[2][t]};
-    int64_t y[3] = {lanes.sy[0][t], lanes.sy[1][t], lanes.sy[2][t]};
-    setup_snapped<Rules>(
-        p, x, y,
-        [&](bool swapped) {
-            const int o = swapped ? 1 : 0;
-            return PlaneCoeffs{lanes.z0[o][t], lanes.dzdx[o][t], lanes.dzdy[o][t]};
-        },
-        draw, out);
+SetupIntRules int_rules(const FrontEndParams& p) {
+    constexpr RuleSet rules = rule_set(Rules);
+    return {rules.bottom_edge_rule,
+            rules.lp_positive_is_ccw,
+            rules.provoking_first,
+            p.front_face == FrontFace::CCW,
+            p.cull_face == CullFace::Front ? 1 : p.cull_face == CullFace::Back ? 2 : 0,
+            p.target_width,
+            p.target_height};
 }
 
 // The rest of setup_triangle_for, from vertices already through the clip test (masks m0..m2) and the
@@ -385,8 +408,9 @@ void setup_range_for(const FrontEndParams& params, std::span<const Float4> verti
     static_assert(kFusedViewport, "setup_avx2.cpp's viewport is the fused one");
     static_assert(sizeof(Float4) == 4 * sizeof(float), "corners are read as 4 floats");
     const std::size_t n = indices.size() / 3 * 3;
-    const bool simd = simd_kernel_active();  // setup's float part 8 triangles at a time (setup_avx2.cpp)
+    const bool simd = simd_kernel_active();  // setup 8 triangles at a time (setup_avx2.cpp)
     const ViewportXform xf = make_xform(rules, params.viewport);
+    const SetupIntRules ints = int_rules<Rules>(params);
     if (n < vertices.size()) {  // a few triangles of a large list (a sub-object's draw): per corner
         std::size_t k = 0;
         // Groups of 8 triangles: the clip test, the viewport, the snap and the depth planes for all
@@ -399,13 +423,14 @@ void setup_range_for(const FrontEndParams& params, std::span<const Float4> verti
                 for (std::size_t j = 0; j < 24; ++j) corners[j] = &vertices[indices[k + j]].x;
                 viewport_lanes8_avx2(lanes, corners, xf.scale, xf.translate, rules.half_z);
                 setup_lanes8_avx2(lanes, rules.provoking_first);
+                setup_ints8_avx2(lanes, ints);
                 for (int t = 0; t < 8; ++t) {
                     const std::size_t c = k + 3 * static_cast<std::size_t>(t);
                     if ((lanes.clipped >> t) & 1u)
                         setup_triangle_for<Rules>(params, vertices[indices[c]], vertices[indices[c + 1]],
                                                   vertices[indices[c + 2]], draw, out);
                     else
-                        setup_lane<Rules>(params, lanes, t, draw, out);
+                        setup_lane(lanes, t, draw, out);
                 }
             }
         }
@@ -459,13 +484,14 @@ void setup_range_for(const FrontEndParams& params, std::span<const Float4> verti
                 }
             }
             setup_lanes8_avx2(lanes, rules.provoking_first);
+            setup_ints8_avx2(lanes, ints);
             for (int t = 0; t < 8; ++t) {
                 const std::size_t c = k + 3 * static_cast<std::size_t>(t);
                 const TransformedVertex &a = cache[indices[c]], &b = cache[indices[c + 1]], &d = cache[indices[c + 2]];
                 if ((clipped >> t) & 1u)
                     setup_transformed<Rules>(params, xf, &a.v, &b.v, &d.v, a.mask, b.mask, d.mask, draw, out);
                 else
-                    setup_lane<Rules>(params, lanes, t, draw, out);
+                    setup_lane(lanes, t, draw, out);
             }
         }
     }

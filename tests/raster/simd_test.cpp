@@ -1029,9 +1029,11 @@ TEST_CASE("setup_range (each vertex transformed once, 8 triangles at a time) == 
     // over a long one (per corner), with a NaN vertex nobody indexes. Every SetupTri field must match.
     // With AVX2, setup_range runs 8 vertices and 8 triangles at a time (setup_avx2.cpp), clipped
     // triangles among them through the scalar front end, and setup_triangle runs the scalar code.
+    // Every third round has a viewport that is not the target (offset, up to 3 times as large), so
+    // that boxes are cut to the target and large triangles fail fits32.
     raster_test::SplitMix64 rng(97531);
-    std::size_t compared = 0;
-    for (int round = 0; round < 200; ++round) {
+    std::size_t compared = 0, cut = 0, wide = 0;
+    for (int round = 0; round < 300; ++round) {
         const int w = 40 + static_cast<int>(rng.below(90)), h = 40 + static_cast<int>(rng.below(90));
         // mode 0: many triangles over a short list; 1: one or two over a long one; 2: 8 to 40 over a
         // longer one (per corner, in groups of 8 triangles when the AVX2 setup runs: setup_avx2.cpp).
@@ -1044,6 +1046,12 @@ TEST_CASE("setup_range (each vertex transformed once, 8 triangles at a time) == 
         std::vector<std::uint32_t> idx;
         for (std::size_t t = 0; t < 3 * n_tris; ++t) idx.push_back(rng.below(static_cast<std::uint32_t>(used)));
         detail::FrontEndParams p = whole_target(w, h);
+        if (round % 3 == 2) {
+            p.viewport.width = w / 2 + static_cast<int>(rng.below(static_cast<std::uint32_t>(5 * w / 2)));
+            p.viewport.height = h / 2 + static_cast<int>(rng.below(static_cast<std::uint32_t>(5 * h / 2)));
+            p.viewport.x = static_cast<int>(rng.below(static_cast<std::uint32_t>(w))) - w / 2;
+            p.viewport.y = static_cast<int>(rng.below(static_cast<std::uint32_t>(h))) - h / 2;
+        }
         p.rules = round % 5 < 2 ? raster::RasterRules::Vulkan : raster::RasterRules::GlLlvmpipe;
         p.cull_face = static_cast<raster::CullFace>(rng.below(3));
         p.front_face = rng.chance(50) ? raster::FrontFace::CCW : raster::FrontFace::CW;
@@ -1062,8 +1070,13 @@ TEST_CASE("setup_range (each vertex transformed once, 8 triangles at a time) == 
                         a.fits32 == b.fits32 && a.front == b.front;
             for (int e = 0; e < 3; ++e) same = same && a.c[e] == b.c[e] && a.dcdx[e] == b.dcdx[e] && a.dcdy[e] == b.dcdy[e];
             CHECK(same);
+            cut += a.x1 == w - 1 || a.y1 == h - 1 || a.x0 == 0 || a.y0 == 0 ? 1u : 0u;
+            wide += a.fits32 ? 0u : 1u;
         }
         compared += per_tri.size();
     }
     CHECK(compared > 3000);
+    // The cases the viewports are for happened.
+    CHECK(cut > 100);
+    CHECK(wide > 20);
 }
