@@ -154,6 +154,12 @@ PlaneCoeffs depth_plane(const ClipVertex* v0, const ClipVertex* v1, const ClipVe
     return {a0, dadx, dady};
 }
 
+// SetupTri::fits32 from the snapped extents span_x = max x - min x, span_y = max y - min y (16.8;
+// each < 2^31): see setup_snapped.
+inline bool fits32_of(int64_t span_x, int64_t span_y) {
+    return span_y * (span_x + 2048) + span_x * (span_y + 256) + 1 < (int64_t{1} << 31);
+}
+
 // llvmpipe's setup of one (post-clip) triangle after the snap: x, y are its corners in 16.8 in the
 // given order, plane_of(swapped) its depth plane for the given order (false) or for the order that
 // setup uses for a negative triangle (true: see below). A template on the rules, so each rule set's
@@ -230,10 +236,7 @@ inline void setup_snapped(const FrontEndParams& p, int64_t* x, int64_t* y, const
     // dcdx (x_i - 256 px) - dcdy (y_i - 256 py) (+1), with |dcdx| <= span_y, |dcdy| <= span_x and,
     // for px in [x0, x1 + 7], py in [y0, y1] (the box rounding above, clamping only narrows it):
     // |x_i - 256 px| <= span_x + 1791, |y_i - 256 py| <= span_y + 255.
-    {
-        const int64_t span_x = maxx - minx, span_y = maxy - miny;
-        t.fits32 = span_y * (span_x + 2048) + span_x * (span_y + 256) + 1 < (int64_t{1} << 31);
-    }
+    t.fits32 = fits32_of(maxx - minx, maxy - miny);
 }
 
 // llvmpipe's setup of one (post-clip) triangle in window coordinates.
@@ -292,8 +295,7 @@ void setup_lane(const SetupLanes8& lanes, int t, std::uint32_t draw, std::vector
     r.dzdy = lanes.dzdy[o][t];
     r.draw = draw;
     r.front = ((lanes.front >> t) & 1u) != 0;
-    const int64_t span_x = lanes.span_x[t], span_y = lanes.span_y[t];  // as setup_snapped's fits32
-    r.fits32 = span_y * (span_x + 2048) + span_x * (span_y + 256) + 1 < (int64_t{1} << 31);
+    r.fits32 = fits32_of(lanes.span_x[t], lanes.span_y[t]);
 }
 
 template <RasterRules Rules>
