@@ -1,8 +1,9 @@
 // setup_avx2.cpp: GL-exact triangle setup for 8 triangles at once (AVX2 + FMA), for the triangles
 // that need no clipping: the float part (viewport, snap, depth planes) and, since session 15, the
-// integer part (area, culling, the orientation swap, box, edge functions: setup_ints8_avx2). CMake compiles this file alone with -mavx2 -mfma
-// -ffp-contract=off (x86-64 GCC/Clang, RASTER_KERNEL_AVX2=1); triangle_setup.cpp calls it only when
-// kernel_avx2_available() says so. Elsewhere it builds to a stub.
+// integer part (area, culling, the orientation swap, box, edge functions: setup_ints8). CMake
+// compiles this file alone with -mavx2 -mfma -ffp-contract=off (x86-64 GCC/Clang,
+// RASTER_KERNEL_AVX2=1); triangle_setup.cpp calls it only when kernel_avx2_available() says so.
+// Elsewhere it builds to a stub.
 //
 // Why: a triangle's setup is a chain of dependent float operations with a division per corner
 // (1/w through the viewport) and one for the depth plane; one triangle at a time, those chains were
@@ -57,40 +58,6 @@ Plane8 plane8(const __m256* v0, const __m256* v1, const __m256* v2) {
     return {a0, dadx, dady};
 }
 
-}  // namespace
-
-void setup_lanes8_avx2(SetupLanes8& io, bool provoking_first) {
-    __m256 v[3][3];
-    for (int k = 0; k < 3; ++k)
-        for (int c = 0; c < 3; ++c) v[k][c] = _mm256_loadu_ps(io.win[k][c]);
-    // Range test and 16.8 snap of x and y: |(w - 0.5) * 256| < 2^30 (false for NaN), then
-    // cvtps2dq of the same product.
-    const __m256 half = _mm256_set1_ps(0.5f), fixed_one = _mm256_set1_ps(256.0f);
-    const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
-    const __m256 limit = _mm256_set1_ps(0x1p30f);
-    __m256 ok = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
-    for (int k = 0; k < 3; ++k) {
-        for (int c = 0; c < 2; ++c) {
-            const __m256 s = _mm256_mul_ps(_mm256_sub_ps(v[k][c], half), fixed_one);
-            ok = _mm256_and_ps(ok, _mm256_cmp_ps(_mm256_and_ps(s, abs_mask), limit, _CMP_LT_OQ));
-            _mm256_storeu_si256(reinterpret_cast<__m256i*>(c == 0 ? io.sx[k] : io.sy[k]), _mm256_cvtps_epi32(s));
-        }
-    }
-    io.in_range = static_cast<std::uint32_t>(_mm256_movemask_ps(ok));
-    // The plane for the vertex order as given and for setup's swap of a negative triangle:
-    // vertices 0 and 1 (provoking vertex last) or 1 and 2 (provoking vertex first).
-    const Plane8 given = plane8(v[0], v[1], v[2]);
-    const Plane8 swapped = provoking_first ? plane8(v[0], v[2], v[1]) : plane8(v[1], v[0], v[2]);
-    _mm256_storeu_ps(io.z0[0], given.z0);
-    _mm256_storeu_ps(io.dzdx[0], given.dzdx);
-    _mm256_storeu_ps(io.dzdy[0], given.dzdy);
-    _mm256_storeu_ps(io.z0[1], swapped.z0);
-    _mm256_storeu_ps(io.dzdx[1], swapped.dzdx);
-    _mm256_storeu_ps(io.dzdy[1], swapped.dzdy);
-}
-
-namespace {
-
 // Bit t of `bits` as lane t's all-ones / zero 32-bit mask.
 __m256i lane_mask(std::uint32_t bits) {
     const __m256i b = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
@@ -124,16 +91,10 @@ std::uint32_t wide_bits(__m256i even, __m256i odd) {
     return r;
 }
 
-}  // namespace
-
-// setup_snapped (triangle_setup.cpp) for 8 triangles: the same integer operations, each exact, so
-// the same values; the per-lane writer there turns each kept lane into its SetupTri.
-void setup_ints8_avx2(SetupLanes8& io, const SetupIntRules& r) {
-    __m256i x[3], y[3];
-    for (int k = 0; k < 3; ++k) {
-        x[k] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(io.sx[k]));
-        y[k] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(io.sy[k]));
-    }
+// setup_snapped (triangle_setup.cpp) for 8 triangles, from their corners snapped to 16.8 (x, y)
+// and the lanes that passed the range test: the same integer operations, each exact, so the same
+// values; the per-lane writer there turns each kept lane into its SetupTri.
+void setup_ints8(SetupLanes8& io, const SetupIntRules& r, __m256i* x, __m256i* y, std::uint32_t in_range) {
     // llvmpipe's area: (x0 - x1) (y2 - y0) - (x2 - x0) (y0 - y1), in 64 bits.
     const Wide area = sub_wide(mul_wide(_mm256_sub_epi32(x[0], x[1]), _mm256_sub_epi32(y[2], y[0])),
                                mul_wide(_mm256_sub_epi32(x[2], x[0]), _mm256_sub_epi32(y[0], y[1])));
@@ -142,7 +103,7 @@ void setup_ints8_avx2(SetupLanes8& io, const SetupIntRules& r) {
     const std::uint32_t positive = wide_bits(_mm256_cmpgt_epi64(area.even, zero), _mm256_cmpgt_epi64(area.odd, zero));
     const std::uint32_t gl_ccw = r.lp_positive_is_ccw ? positive : ~positive & 0xffu;
     const std::uint32_t front = r.front_is_ccw ? gl_ccw : ~gl_ccw & 0xffu;
-    std::uint32_t keep = io.in_range & nonzero;
+    std::uint32_t keep = in_range & nonzero;
     if (r.cull == 2) keep &= front;
     if (r.cull == 1) keep &= ~front;
     // The swap of a negative triangle: vertices 0 and 1, or 1 and 2 with the provoking vertex first.
@@ -193,6 +154,40 @@ void setup_ints8_avx2(SetupLanes8& io, const SetupIntRules& r) {
     io.keep = keep;
     io.swapped = ~positive & 0xffu;
     io.front = front;
+}
+
+}  // namespace
+
+void setup_lanes8_avx2(SetupLanes8& io, const SetupIntRules& rules) {
+    __m256 v[3][3];
+    for (int k = 0; k < 3; ++k)
+        for (int c = 0; c < 3; ++c) v[k][c] = _mm256_loadu_ps(io.win[k][c]);
+    // Range test and 16.8 snap of x and y: |(w - 0.5) * 256| < 2^30 (false for NaN), then
+    // cvtps2dq of the same product.
+    const __m256 half = _mm256_set1_ps(0.5f), fixed_one = _mm256_set1_ps(256.0f);
+    const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+    const __m256 limit = _mm256_set1_ps(0x1p30f);
+    __m256 ok = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+    __m256i snapped[2][3];  // [0] x, [1] y of each corner
+    for (int k = 0; k < 3; ++k) {
+        for (int c = 0; c < 2; ++c) {
+            const __m256 s = _mm256_mul_ps(_mm256_sub_ps(v[k][c], half), fixed_one);
+            ok = _mm256_and_ps(ok, _mm256_cmp_ps(_mm256_and_ps(s, abs_mask), limit, _CMP_LT_OQ));
+            snapped[c][k] = _mm256_cvtps_epi32(s);
+        }
+    }
+    const auto in_range = static_cast<std::uint32_t>(_mm256_movemask_ps(ok));
+    // The plane for the vertex order as given and for setup's swap of a negative triangle:
+    // vertices 0 and 1 (provoking vertex last) or 1 and 2 (provoking vertex first).
+    const Plane8 given = plane8(v[0], v[1], v[2]);
+    const Plane8 swapped = rules.provoking_first ? plane8(v[0], v[2], v[1]) : plane8(v[1], v[0], v[2]);
+    _mm256_storeu_ps(io.z0[0], given.z0);
+    _mm256_storeu_ps(io.dzdx[0], given.dzdx);
+    _mm256_storeu_ps(io.dzdy[0], given.dzdy);
+    _mm256_storeu_ps(io.z0[1], swapped.z0);
+    _mm256_storeu_ps(io.dzdx[1], swapped.dzdx);
+    _mm256_storeu_ps(io.dzdy[1], swapped.dzdy);
+    setup_ints8(io, rules, snapped[0], snapped[1], in_range);
 }
 
 namespace {
@@ -271,8 +266,7 @@ void vertices8_avx2(const float* vertices, const float scale[3], const float tra
 
 #else
 
-void setup_lanes8_avx2(SetupLanes8&, bool) {}
-void setup_ints8_avx2(SetupLanes8&, const SetupIntRules&) {}
+void setup_lanes8_avx2(SetupLanes8&, const SetupIntRules&) {}
 void viewport_lanes8_avx2(SetupLanes8&, const float* const[24], const float[3], const float[3], bool) {}
 void vertices8_avx2(const float*, const float[3], const float[3], bool, float[3][8], std::uint32_t[8]) {}
 

@@ -12,19 +12,16 @@ struct SetupLanes8 {
     // viewport_lanes8: bit t set when a corner of triangle t is outside the clip volume (clip_mask
     // is not zero: the scalar front end clips it).
     std::uint32_t clipped = 0;
-    // setup_lanes8: bit t set when every corner of triangle t passes setup's fixed-point range
-    // test; then sx, sy are its corners snapped to 16.8 (as setup_window_triangle snaps them).
-    std::uint32_t in_range = 0;
-    std::int32_t sx[3][8], sy[3][8];
     // setup_lanes8: the depth plane of the corners in the given order ([0]) and in the order setup
     // uses for a negative triangle ([1]: corners 0 and 1 swapped, or 1 and 2 when the provoking
     // vertex is the first).
     float z0[2][8], dzdx[2][8], dzdy[2][8];
-    // setup_ints8: the integer part of setup (triangle_setup.cpp, setup_snapped) for the lanes in
-    // range. keep bit t: triangle t makes a SetupTri (area not 0, not culled, box not empty); then
-    // its box, its edges in setup's vertex order (after the swap of a negative triangle) with the
-    // fill-rule bias in bias_bits (bit t of [e]: add 1 to c[e][t]), swapped bit t: the plane is
-    // [1], front bit t: front-facing, and the snapped extents for fits32.
+    // setup_lanes8, the integer part of setup (triangle_setup.cpp, setup_snapped) on the corners
+    // snapped to 16.8. keep bit t: triangle t makes a SetupTri (every corner in the fixed-point
+    // range, area not 0, not culled, box not empty); then its box, its edges in setup's vertex order
+    // (after the swap of a negative triangle) with the fill-rule bias in bias_bits (bit t of [e]: add
+    // 1 to c[e][t]), swapped bit t: the plane is [1], front bit t: front-facing, and the snapped
+    // extents for fits32.
     std::uint32_t keep = 0, swapped = 0, front = 0;
     std::uint32_t bias_bits[3] = {0, 0, 0};
     std::int32_t box[4][8];  // x0, y0, x1, y1, inside the target
@@ -33,7 +30,7 @@ struct SetupLanes8 {
     std::int32_t span_x[8], span_y[8];
 };
 
-// What setup_ints8 needs of the rules and the draw (triangle_setup.cpp's RuleSet and
+// What setup_lanes8 needs of the rules and the draw (triangle_setup.cpp's RuleSet and
 // FrontEndParams).
 struct SetupIntRules {
     bool bottom_edge_rule;
@@ -44,12 +41,11 @@ struct SetupIntRules {
     int target_width, target_height;
 };
 
-// Fills in_range, sx, sy, z0, dzdx and dzdy from win. Call only where kernel_avx2_available():
-// a build without AVX2 code has empty stubs.
-void setup_lanes8_avx2(SetupLanes8& io, bool provoking_first);
-// Fills keep .. span_y from sx, sy and in_range (after setup_lanes8_avx2): 64-bit products from
-// 32-bit lanes (|snapped| < 2^30, so every difference fits 32 bits and every product 62).
-void setup_ints8_avx2(SetupLanes8& io, const SetupIntRules& rules);
+// Setup of the 8 triangles whose window corners are in win: the snap and range test, the depth
+// planes (z0 .. dzdy), then the integer part (keep .. span_y) with 64-bit products from 32-bit
+// lanes (|snapped| < 2^30, so every difference fits 32 bits and every product 62). Call only
+// where kernel_avx2_available(): a build without AVX2 code has an empty stub.
+void setup_lanes8_avx2(SetupLanes8& io, const SetupIntRules& rules);
 // The clip test and the viewport of 8 triangles' corners: corners[3 t + k] is corner k of
 // triangle t (x, y, z, w). Fills win and clipped (the same condition as setup_lanes8_avx2).
 void viewport_lanes8_avx2(SetupLanes8& io, const float* const corners[24], const float scale[3],

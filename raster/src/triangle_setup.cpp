@@ -272,7 +272,7 @@ void setup_window_triangle(const FrontEndParams& p, const ClipVertex* v0, const 
         draw, out);
 }
 
-// Lane t of setup_lanes8 and setup_ints8: setup_window_triangle's result, from the lanes' snap,
+// Lane t of setup_lanes8: setup_window_triangle's result, from the lanes' snap,
 // planes and integer setup (setup_avx2.cpp: the same operations, so the same values). Only the
 // record is written here; the integer part ran 8 triangles at a time (its compares and selects
 // per triangle, the orientation swap above all, were most of this function's samples on small
@@ -424,8 +424,7 @@ void setup_range_for(const FrontEndParams& params, std::span<const Float4> verti
             for (; k + 24 <= n; k += 24) {
                 for (std::size_t j = 0; j < 24; ++j) corners[j] = &vertices[indices[k + j]].x;
                 viewport_lanes8_avx2(lanes, corners, xf.scale, xf.translate, rules.half_z);
-                setup_lanes8_avx2(lanes, rules.provoking_first);
-                setup_ints8_avx2(lanes, ints);
+                setup_lanes8_avx2(lanes, ints);
                 for (int t = 0; t < 8; ++t) {
                     const std::size_t c = k + 3 * static_cast<std::size_t>(t);
                     if ((lanes.clipped >> t) & 1u)
@@ -485,8 +484,7 @@ void setup_range_for(const FrontEndParams& params, std::span<const Float4> verti
                     clipped |= v.mask != 0 ? (1u << t) : 0u;
                 }
             }
-            setup_lanes8_avx2(lanes, rules.provoking_first);
-            setup_ints8_avx2(lanes, ints);
+            setup_lanes8_avx2(lanes, ints);
             for (int t = 0; t < 8; ++t) {
                 const std::size_t c = k + 3 * static_cast<std::size_t>(t);
                 const TransformedVertex &a = cache[indices[c]], &b = cache[indices[c + 1]], &d = cache[indices[c + 2]];

@@ -147,8 +147,8 @@ struct TileGrid {
 constexpr std::uint8_t kOccNone = 0, kOccOne = 1, kOccMany = 2;
 
 // The cells of the pixel box [x0, x1] x [y0, y1] reached by the object `k`.
-template <class Key>
-void occ_mark(const detail::CellGrid& g, Key* key, std::uint8_t* state, int x0, int y0, int x1, int y1, Key k) {
+void occ_mark(const detail::CellGrid& g, std::uint32_t* key, std::uint8_t* state, int x0, int y0, int x1, int y1,
+              std::uint32_t k) {
     for (int cy = y0 >> g.shift; cy <= y1 >> g.shift; ++cy) {
         const std::size_t row = static_cast<std::size_t>(cy) * static_cast<std::size_t>(g.x);
         for (int cx = x0 >> g.shift; cx <= x1 >> g.shift; ++cx) {
@@ -163,7 +163,7 @@ void occ_mark(const detail::CellGrid& g, Key* key, std::uint8_t* state, int x0, 
     }
 }
 
-// Whether every cell of the pixel box is reached by one key only.
+// Whether every cell of the pixel box is reached by one object only.
 inline bool occ_one(const detail::CellGrid& g, const std::uint8_t* state, int x0, int y0, int x1, int y1) {
     for (int cy = y0 >> g.shift; cy <= y1 >> g.shift; ++cy) {
         const std::size_t row = static_cast<std::size_t>(cy) * static_cast<std::size_t>(g.x);
