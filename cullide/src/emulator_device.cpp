@@ -22,7 +22,7 @@ Result<bool> EmulatorDevice::ensure_target(int width, int height, raster::DepthF
     target_.emplace(std::move(t).value());
     // A new target is created cleared to 1.0: nothing written yet.
     constexpr int side = raster::kExecuteTileSize;
-    written_tiles_.assign(static_cast<std::size_t>((width + side - 1) / side) * static_cast<std::size_t>((height + side - 1) / side), 0);
+    written_blocks_.assign(static_cast<std::size_t>((width + side - 1) / side) * static_cast<std::size_t>((height + side - 1) / side), 0);
     return true;
 }
 
@@ -30,9 +30,9 @@ Status EmulatorDevice::clear(int width, int height, raster::DepthFormat format) 
     Result<bool> created = ensure_target(width, height, format);
     if (!created) return created.error();
     if (created.value()) return Status{};
-    // Only the tiles where raster::execute ran a writing draw (ExecuteOptions::written_tiles) can
-    // differ from depth 1.0: an empty batch with clear_depth restores exactly those, each in its own
-    // tile task, which gives the same buffer as a full clear.
+    // Only the 8 x 8 blocks where a writing draw of raster::execute passed the depth test
+    // (ExecuteOptions::written_blocks) can differ from depth 1.0: an empty batch with clear_depth
+    // restores exactly those, each tile's in its own task, which gives the same buffer as a full clear.
     raster::ExecuteOptions options = execute_options();
     options.clear_depth = 1.0;
     raster::Result<raster::QueryResults> r = raster::execute(*target_, raster::CommandBatch(width, height), options);
@@ -43,15 +43,15 @@ Status EmulatorDevice::clear(int width, int height, raster::DepthFormat format) 
 raster::ExecuteOptions EmulatorDevice::execute_options() {
     raster::ExecuteOptions eo;
     eo.threads = threads_;
-    eo.written_tiles = &written_tiles_;  // the tiles the next clear restores
+    eo.written_blocks = &written_blocks_;  // the blocks the next clear restores
     return eo;
 }
 
 Result<std::vector<raster::QueryResults>> EmulatorDevice::execute_cleared(
     int width, int height, raster::DepthFormat format, std::span<const raster::CommandBatch* const> batches) {
     if (Result<bool> created = ensure_target(width, height, format); !created) return created.error();
-    // Each batch on a cleared target, as clear() before it, but each written tile is restored by
-    // its own tile task before it draws there (ExecuteOptions::clear_depth): in parallel with the
+    // Each batch on a cleared target, as clear() before it, but each written block is restored by
+    // its tile's own task before it draws there (ExecuteOptions::clear_depth): in parallel with the
     // other tiles' work and while the tile is in that core's cache, without a pass of its own.
     raster::ExecuteOptions options = execute_options();
     options.clear_depth = 1.0;

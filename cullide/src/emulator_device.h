@@ -42,7 +42,7 @@ class EmulatorDevice final : public QueryDevice {
     [[nodiscard]] const raster::DepthTarget* target() const { return target_ ? &*target_ : nullptr; }
 
    private:
-    // The executor's options for this device: its thread count, and the written tiles the next
+    // The executor's options for this device: its thread count, and the written blocks the next
     // clear restores.
     raster::ExecuteOptions execute_options();
     // Makes target_ a width x height target of `format`: true when it was created (cleared to 1.0,
@@ -51,10 +51,10 @@ class EmulatorDevice final : public QueryDevice {
 
     int threads_;
     std::optional<raster::DepthTarget> target_;
-    // Per 64 x 64 tile of the target (raster::kExecuteTileSize, row-major): 1 when a draw with the
-    // depth mask on was rasterized in it since the last clear (filled in by raster::execute,
-    // ExecuteOptions::written_tiles; a clear resets what it restores).
-    std::vector<std::uint8_t> written_tiles_;
+    // Per 64 x 64 tile of the target (raster::kExecuteTileSize, row-major), a mask of its 8 x 8
+    // blocks where a draw with the depth mask on passed the depth test since the last clear (filled
+    // in by raster::execute, ExecuteOptions::written_blocks; a clear resets what it restores).
+    std::vector<std::uint64_t> written_blocks_;
 };
 
 }  // namespace cullide::detail

@@ -1,6 +1,7 @@
 // execute.cpp: the scalar reference executor and the tiled (optionally multithreaded) executor.
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <atomic>
@@ -665,12 +666,44 @@ struct ShadeContext {
     bool allow_simd;
     bool hiz;                     // hierarchical Z on D16 / D24 targets (pipeline.h, HizTile)
     detail::HizTile* hiz_tiles;   // per tile, owned by the tile's task
-    std::uint8_t* written_tiles;  // per tile: set to 1 when a writing draw ran in it (or nullptr)
+    std::uint64_t* written_blocks;  // per tile: the 8 x 8 blocks where a writing draw passed (or nullptr)
     std::atomic<bool>* answered;  // per query: an any-samples query already has a passing sample
-    // ExecuteOptions::clear_depth: fill the tile with kTileSize copies of *clear_row first (all
-    // tiles, or with written_tiles those flagged); nullptr: no clear.
+    // ExecuteOptions::clear_depth: fill the tile with copies of *clear_row (kTileSize values) first
+    // (all of it, or with written_blocks the blocks flagged); nullptr: no clear.
     const std::uint32_t* clear_row;
 };
+
+// Fills the blocks of `tile` flagged in `mask` (ExecuteOptions::written_blocks' layout) with copies
+// of `clear_row` (kTileSize values). Each row part by memcpy (wide stores on any target; the element
+// loop of std::fill stored one value per instruction): the whole tile row by row when every block
+// is flagged, else each block row's runs of flagged blocks. A target of 4096^2 holds 64 MB and
+// raster_bench SmallTris writes about one block in six there: restoring only those is most of the
+// difference (docs/raster.md, session 16).
+void clear_blocks(detail::DepthRows depth, const std::uint32_t* clear_row, detail::PixelRect tile, std::uint64_t mask) {
+    constexpr int B = kExecuteBlockSize;
+    static_assert(kTileSize == 8 * B, "one bit per block of a tile in a 64-bit mask");
+    if (mask == ~std::uint64_t{0}) {
+        for (int y = tile.y0; y <= tile.y1; ++y)
+            std::memcpy(depth.row(y) + tile.x0, clear_row, static_cast<std::size_t>(tile.x1 - tile.x0 + 1) * sizeof(std::uint32_t));
+        return;
+    }
+    for (int by = 0; mask != 0; ++by, mask >>= 8) {
+        unsigned bits = static_cast<unsigned>(mask & 0xffu);
+        const int ya = tile.y0 + by * B;
+        if (bits == 0 || ya > tile.y1) continue;
+        const int yb = std::min(ya + B - 1, tile.y1);
+        while (bits != 0) {  // each run of flagged blocks [b0, b1)
+            const int b0 = std::countr_zero(bits);
+            const int b1 = b0 + std::countr_one(bits >> b0);
+            bits &= ~((1u << b1) - (1u << b0));
+            const int xa = tile.x0 + b0 * B;
+            if (xa > tile.x1) break;
+            const int xb = std::min(tile.x0 + b1 * B - 1, tile.x1);
+            for (int y = ya; y <= yb; ++y)
+                std::memcpy(depth.row(y) + xa, clear_row, static_cast<std::size_t>(xb - xa + 1) * sizeof(std::uint32_t));
+        }
+    }
+}
 
 // How many bin references ahead shade prefetches a GL-exact triangle's set-up record.
 constexpr std::size_t kPrefetchAhead = 4;
@@ -699,18 +732,21 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
         }
     };
     for (std::size_t j = 0; j < kPrefetchAhead && j < bin.size(); ++j) prefetch(bin[j]);
-    if (ctx.clear_row != nullptr && (ctx.written_tiles == nullptr || ctx.written_tiles[tile_index] != 0)) {
-        // Each row by memcpy from a row of clear values (wide stores on any target; the element
-        // loop of std::fill stored one value per instruction: emulator_device.cpp).
-        for (int y = y0; y <= y1; ++y)
-            std::memcpy(ctx.depth.row(y) + x0, ctx.clear_row, static_cast<std::size_t>(x1 - x0 + 1) * sizeof(std::uint32_t));
-        if (ctx.written_tiles != nullptr) ctx.written_tiles[tile_index] = 0;
+    std::uint64_t* const written = ctx.written_blocks != nullptr ? &ctx.written_blocks[tile_index] : nullptr;
+    if (ctx.clear_row != nullptr) {
+        clear_blocks(ctx.depth, ctx.clear_row, {x0, y0, x1, y1}, written != nullptr ? *written : ~std::uint64_t{0});
+        if (written != nullptr) *written = 0;
     }
     if (hiz != nullptr) {
         hiz->tile = {x0, y0, x1, y1};
         hiz->valid = 0;  // bounds are read from the buffer afresh in every batch
     }
-    bool wrote = false;
+    // The blocks where a writing draw passed the depth test in this batch (a kernel's count is the
+    // number of samples that passed, and a writing draw writes exactly those).
+    std::uint64_t wrote = 0;
+    const auto mark = [&](const detail::PixelRect& rect) __attribute__((always_inline)) {
+        wrote |= detail::block_mask((rect.x0 - x0) >> 3, (rect.x1 - x0) >> 3, (rect.y0 - y0) >> 3, (rect.y1 - y0) >> 3);
+    };
     const std::size_t n_refs = bin.size();
     for (std::size_t j = 0; j < n_refs; ++j) {
         if (j + kPrefetchAhead < n_refs) prefetch(bin[j + kPrefetchAhead]);
@@ -721,10 +757,10 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
         if (info.exact_bounds) {
             const Command& c = *ctx.draws.cmd[r.draw];
             const detail::DepthState depth_state{ctx.format, c.state.depth_func, c.state.depth_write};
-            if (c.state.depth_write) wrote = true;
             const auto& tri = ctx.setup.bounds[r.draw][r.tri];
-            passed = detail::bounds_rect(tri, ctx.setup.pool[r.draw].data(), depth_state, ctx.depth,
-                                         clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1));
+            const detail::PixelRect rect = clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1);
+            passed = detail::bounds_rect(tri, ctx.setup.pool[r.draw].data(), depth_state, ctx.depth, rect);
+            if (c.state.depth_write && passed != 0) mark(rect);
             if (hiz != nullptr && c.state.depth_write) hiz->valid = 0;  // its writes are not tracked
         } else {
             // Any-samples query with the mask off: once this query has a passing sample (in this
@@ -734,7 +770,6 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
             if (any_only && ((!counts.empty() && counts.back().first == q) ||
                              ctx.answered[q].load(std::memory_order_relaxed)))
                 continue;
-            if (info.write) wrote = true;
             const detail::SetupTri& tri = info.tris[r.tri];
             detail::PixelRect rect = clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1);
             // A triangle over several tiles: its part of this tile may be much smaller than the
@@ -744,13 +779,14 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
                 (rect.x1 - rect.x0 + 1) * (rect.y1 - rect.y0 + 1) >= kShrinkMinArea && !detail::shrink_rect(tri, rect))
                 continue;
             passed = info.kernel(tri, ctx.depth, rect, hiz, any_only);
+            if (info.write && passed != 0) mark(rect);
             if (any_only && passed != 0) ctx.answered[q].store(true, std::memory_order_relaxed);
         }
         if (q == kNoQuery || passed == 0) continue;
         if (!counts.empty() && counts.back().first == q) counts.back().second += passed;
         else counts.emplace_back(q, passed);
     }
-    if (wrote && ctx.written_tiles != nullptr) ctx.written_tiles[tile_index] = 1;
+    if (written != nullptr) *written |= wrote;
 }
 
 }  // namespace
@@ -829,15 +865,16 @@ Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::spa
         const std::size_t n_queries = batch.query_kinds().size();
         if (scratch.answered.size() < n_queries + 1) scratch.answered = std::vector<std::atomic<bool>>(n_queries + 1);
         for (std::size_t q = 0; q <= n_queries; ++q) scratch.answered[q].store(false, std::memory_order_relaxed);
-        // Resized: new entries 0 (nothing written), or 1 when this call clears (content unknown).
-        if (options.written_tiles != nullptr && options.written_tiles->size() != tiles.count())
-            options.written_tiles->assign(tiles.count(), options.clear_depth ? 1 : 0);
+        // Resized: new entries 0 (nothing written), or every block when this call clears (content
+        // unknown).
+        if (options.written_blocks != nullptr && options.written_blocks->size() != tiles.count())
+            options.written_blocks->assign(tiles.count(), options.clear_depth ? ~std::uint64_t{0} : 0);
         draw_infos(batch, draw_list, d0, d1, setup, target.format(), options.allow_simd, hiz, scratch.infos);
         const ShadeContext ctx{draw_list,      setup,           scratch.infos.data(),
                                {target.mutable_values().data(), target.width()},
                                target.width(), target.height(), target.format(),
                                options.allow_simd, hiz, scratch.hiz_tiles.data(),
-                               options.written_tiles != nullptr ? options.written_tiles->data() : nullptr,
+                               options.written_blocks != nullptr ? options.written_blocks->data() : nullptr,
                                scratch.answered.data(), options.clear_depth ? clear_row.data() : nullptr};
         auto& tile_counts = scratch.tile_counts;
         reset_lists(tile_counts, tiles.count());

@@ -132,6 +132,16 @@ struct HizTile {
     std::uint32_t lo[64];      // every stored value of the block is >= lo ...
     std::uint32_t hi[64];      // ... and <= hi
 };
+// The 8 x 8 blocks [bx0, bx1] x [by0, by1] of a tile (each in 0..7) as a mask, bit by * 8 + bx (the
+// layout of HizTile::valid and ExecuteOptions::written_blocks): the row's bits (under 256) times one
+// bit per block row (whole bytes, so the product has no carries), without a loop. Empty (0) when
+// by1 < by0.
+[[gnu::always_inline]] inline std::uint64_t block_mask(int bx0, int bx1, int by0, int by1) {
+    if (by1 < by0) return 0;
+    const std::uint64_t row = ((std::uint64_t{2} << bx1) - 1) & ~((std::uint64_t{1} << bx0) - 1);
+    const std::uint64_t rows = (std::uint64_t{0x0101010101010101} >> (8 * (7 - (by1 - by0)))) << (8 * by0);
+    return row * rows;
+}
 // raster_rect with the tile's block bounds: skips the blocks where the depth test certainly fails,
 // runs the kernel on the rest (in runs of blocks); writing draws run it on all of rect. `rect` lies
 // inside hiz.tile. Same samples and the same stored values as raster_rect on `rect`: the skipped

@@ -11,6 +11,9 @@
 //   LargeTris/<size>/<threads>: 200 triangles covering ~1/8 of the target each, LESS, writes on.
 //   CullideAny/<size>/<threads>: Cullide with any-samples queries (what cullide.cpp issues): the
 //     executor stops a query at its first passing sample.
+//   SmallTrisRestore, LargeTrisRestore: the emulator on SmallTris and LargeTris, each run's clear
+//     restoring only the 8 x 8 blocks the previous run wrote (ExecuteOptions::written_blocks, as
+//     CULLIDE's emulator device clears); checked after timing: the buffer equals a full clear's.
 // threads = 0 means the OSMesa oracle (llvmpipe with its default thread count). A third argument
 // simd: 1 = default kernel choice (AVX2 8-wide when the CPU has it), 0 = the portable kernel.
 //   Reliable/<size>/<mode>: the Cullide workload's 2000 boxes (world = clip: a [-1, 1]^3 view along
@@ -21,6 +24,7 @@
 //     objects each mode calls fully visible is reported (counter "visible").
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -121,7 +125,11 @@ std::uint64_t digest(const raster::QueryResults& r) {
     return h;
 }
 
-void run(benchmark::State& state, Kind kind) {
+// restore_written: the timed runs keep ExecuteOptions::written_blocks from one run to the next, so
+// that each run's clear restores only the 8 x 8 blocks the previous run wrote (how CULLIDE's
+// emulator device clears between passes); the buffer and results are those of a full clear. Off:
+// every run fills the whole buffer, as llvmpipe does.
+void run(benchmark::State& state, Kind kind, bool restore_written) {
     const int size = static_cast<int>(state.range(0));
     const int threads = static_cast<int>(state.range(1));
     const bool simd = state.range(2) != 0;
@@ -171,14 +179,25 @@ void run(benchmark::State& state, Kind kind) {
         // tile's task filling its tile first (a separate DepthTarget::clear is one serial pass).
         raster::ExecuteOptions options{threads, simd};
         options.clear_depth = 1.0;
+        std::vector<std::uint64_t> written;  // empty: the first run fills every block
+        if (restore_written) options.written_blocks = &written;
         for (auto _ : state) {
             auto r = raster::execute(target.value(), w->batch, options);
             benchmark::DoNotOptimize(r);
         }
+        if (restore_written) {  // the restored buffer is the fully cleared one
+            auto full = raster::DepthTarget::create(size, size, raster::DepthFormat::D24);
+            auto r = raster::execute(full.value(), w->batch, raster::ExecuteOptions{threads, simd});
+            const auto a = target.value().values(), b = full.value().values();
+            if (!r.ok() || digest(r.value()) != want || !std::equal(a.begin(), a.end(), b.begin(), b.end()))
+                state.SkipWithError("restoring the written blocks gave another buffer than a full clear");
+        }
     }
     state.counters["tris/s"] = benchmark::Counter(static_cast<double>(w->triangles), benchmark::Counter::kIsIterationInvariantRate);
     state.counters["queries/s"] = benchmark::Counter(static_cast<double>(w->queries), benchmark::Counter::kIsIterationInvariantRate);
-    state.SetLabel(threads == 0 ? "osmesa-llvmpipe" : (simd ? "cullide-raster" : "cullide-raster-portable"));
+    state.SetLabel(threads == 0 ? "osmesa-llvmpipe"
+                                : std::string(simd ? "cullide-raster" : "cullide-raster-portable") +
+                                      (restore_written ? "+written-blocks" : ""));
 }
 
 void args(benchmark::internal::Benchmark* b) {
@@ -187,6 +206,13 @@ void args(benchmark::internal::Benchmark* b) {
             b->Args({size, threads, 1});
             if (threads == 1) b->Args({size, threads, 0});  // the portable (scalar) kernel, SIMD off
         }
+    b->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+
+// The emulator alone (the OSMesa rows are the plain workload's), AVX2 kernel.
+void args_emulator(benchmark::internal::Benchmark* b) {
+    for (const int size : {256, 1024, 4096})
+        for (const int threads : {1, 2}) b->Args({size, threads, 1});
     b->Unit(benchmark::kMillisecond)->UseRealTime();
 }
 
@@ -270,10 +296,12 @@ void run_reliable(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(run_reliable)->ArgsProduct({{256, 1024}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(run, Cullide, Kind::Cullide)->Apply(args);
-BENCHMARK_CAPTURE(run, SmallTris, Kind::SmallTris)->Apply(args);
-BENCHMARK_CAPTURE(run, LargeTris, Kind::LargeTris)->Apply(args);
-BENCHMARK_CAPTURE(run, CullideAny, Kind::CullideAny)->Apply(args);
+BENCHMARK_CAPTURE(run, Cullide, Kind::Cullide, false)->Apply(args);
+BENCHMARK_CAPTURE(run, SmallTris, Kind::SmallTris, false)->Apply(args);
+BENCHMARK_CAPTURE(run, LargeTris, Kind::LargeTris, false)->Apply(args);
+BENCHMARK_CAPTURE(run, SmallTrisRestore, Kind::SmallTris, true)->Apply(args_emulator);
+BENCHMARK_CAPTURE(run, LargeTrisRestore, Kind::LargeTris, true)->Apply(args_emulator);
+BENCHMARK_CAPTURE(run, CullideAny, Kind::CullideAny, false)->Apply(args);
 
 namespace {
 

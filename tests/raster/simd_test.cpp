@@ -798,7 +798,7 @@ TEST_CASE("execute_sequence == execute per batch with the clear between, and an 
 
 // The sequence with queries_only on 1, 2 and 3 threads against `want`, full execution's results
 // (its final target `want_t`): `calls` calls on one fresh target each, with clear_depth = 1 when
-// `cleared` and then written_tiles kept across the calls when `tiles`, as the emulator device runs
+// `cleared` and then written_blocks kept across the calls when `tiles`, as the emulator device runs
 // view after view. Counts the runs and those whose final depth differs from full execution's.
 namespace {
 void check_queries_only(const std::vector<const raster::CommandBatch*>& ptrs, DepthFormat f, bool cleared, bool tiles,
@@ -807,11 +807,11 @@ void check_queries_only(const std::vector<const raster::CommandBatch*>& ptrs, De
     for (const int threads : {1, 2, 3}) {
         CAPTURE(threads);
         auto t = raster::DepthTarget::create(want_t.width(), want_t.height(), f).value();
-        std::vector<std::uint8_t> written;
+        std::vector<std::uint64_t> written;
         raster::ExecuteOptions o{threads, true};
         o.queries_only = true;
         if (cleared) o.clear_depth = 1.0;
-        if (tiles) o.written_tiles = &written;
+        if (tiles) o.written_blocks = &written;
         for (int call = 0; call < calls; ++call) {
             const auto got = raster::execute_sequence(t, ptrs, o);
             REQUIRE(got.ok());
@@ -830,7 +830,7 @@ void check_queries_only(const std::vector<const raster::CommandBatch*>& ptrs, De
 // ALWAYS queries, samples-passed counts, items at the far plane (z = 1: GEQUAL passes on the clear
 // value) and beyond it (clipped there), w != 1, outside the target, viewports, exact-bounds
 // double input, Vulkan's rules; with clear_depth = 1 (both rules) and without (writes only), with
-// written_tiles kept across calls as the emulator device keeps them; 1, 2 and 3 threads.
+// written_blocks kept across calls as the emulator device keeps them; 1, 2 and 3 threads.
 TEST_CASE("queries_only skips unobserved draws with the same query results") {
     raster_test::SplitMix64 rng(0x9a11u);
     int differs = 0, runs = 0;
@@ -915,7 +915,7 @@ TEST_CASE("queries_only skips unobserved draws with the same query results") {
                 CAPTURE(rep);
                 CAPTURE(static_cast<int>(f));
                 CAPTURE(cleared);
-                // Cleared: twice on one target with written_tiles (the target's content after a call
+                // Cleared: twice on one target with written_blocks (the target's content after a call
                 // is unspecified, so without clear_depth a second call would start from it).
                 check_queries_only(ptrs, f, cleared, cleared, cleared ? 2 : 1, want.value(), want_t, runs, differs);
             }

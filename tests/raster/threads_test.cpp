@@ -180,32 +180,43 @@ TEST_CASE("Draws of the same spans share their setup only when the front-end sta
     CHECK(want.value()[0] == want.value()[5]);
 }
 
-TEST_CASE("written_tiles flags every tile whose pixels a batch changed, and only tiles with writing draws") {
+// The bit of pixel (x, y) in ExecuteOptions::written_blocks (tiles_x tiles per row).
+namespace {
+bool block_flagged(const std::vector<std::uint64_t>& flags, int tiles_x, int x, int y) {
+    const std::uint64_t mask = flags[static_cast<std::size_t>(y / 64 * tiles_x + x / 64)];
+    return ((mask >> ((y % 64) / 8 * 8 + (x % 64) / 8)) & 1u) != 0;
+}
+}  // namespace
+
+TEST_CASE("written_blocks flags every block whose pixels a batch changed, and only blocks with passing writes") {
     raster_test::SplitMix64 rng(606);
-    std::uint64_t changed_total = 0;
+    std::uint64_t changed_total = 0, unflagged_blocks = 0;
     for (int rep = 0; rep < 6; ++rep) {
         CAPTURE(rep);
         raster_test::Scene scene;
         raster_test::build_scene(scene, rng, {.width = 333, .height = 200, .objects = 80});
         auto t = raster::DepthTarget::create(333, 200, raster::DepthFormat::D24).value();
         const std::vector<std::uint32_t> before(t.values().begin(), t.values().end());
-        std::vector<std::uint8_t> flags;
+        std::vector<std::uint64_t> flags;
         raster::ExecuteOptions eo{1 + rep % 2};
-        eo.written_tiles = &flags;
+        eo.written_blocks = &flags;
         REQUIRE(raster::execute(t, scene.batch, eo).ok());
         const int tiles_x = (333 + raster::kExecuteTileSize - 1) / raster::kExecuteTileSize;
         REQUIRE(flags.size() == static_cast<std::size_t>(tiles_x) * 4);
         for (int y = 0; y < 200; ++y)
             for (int x = 0; x < 333; ++x) {
                 const std::size_t i = static_cast<std::size_t>(y) * 333 + static_cast<std::size_t>(x);
+                if (x % 8 == 0 && y % 8 == 0 && !block_flagged(flags, tiles_x, x, y)) ++unflagged_blocks;
                 if (t.values()[i] == before[i]) continue;
                 ++changed_total;
-                CHECK(flags[static_cast<std::size_t>(y / 64 * tiles_x + x / 64)] == 1);
+                CHECK(block_flagged(flags, tiles_x, x, y));
             }
     }
     CHECK(changed_total > 1000);
+    CHECK(unflagged_blocks > 0);  // not every block: the flags are finer than the tiles
 
-    // One written triangle in the bottom-left tile and a query over the whole target: one flag.
+    // One written triangle over the pixels [0, 19] x [0, 19] of the bottom-left tile, a query over the
+    // whole target, and a writing draw that fails everywhere (NEVER): the blocks [0, 2] x [0, 2].
     std::vector<raster::Float4> small{{-1.0f, -1.0f, 0.0f, 1}, {-0.8f, -1.0f, 0.0f, 1}, {-1.0f, -0.8f, 0.0f, 1}};
     std::vector<raster::Float4> big{{-1, -1, 0.5f, 1}, {3, -1, 0.5f, 1}, {-1, 3, 0.5f, 1}};
     const std::vector<std::uint32_t> tri{0, 1, 2};
@@ -217,27 +228,31 @@ TEST_CASE("written_tiles flags every tile whose pixels a batch changed, and only
     batch.begin_query(raster::QueryKind::SamplesPassed);
     batch.draw(raster::MeshView{big, tri}, q);
     batch.end_query();
+    raster::DrawState never;
+    never.depth_func = raster::DepthFunc::Never;
+    batch.draw(raster::MeshView{big, tri}, never);
     auto t = raster::DepthTarget::create(200, 200, raster::DepthFormat::D24).value();
-    std::vector<std::uint8_t> flags(16, 0);
+    std::vector<std::uint64_t> flags(16, 0);
     raster::ExecuteOptions eo;
-    eo.written_tiles = &flags;
+    eo.written_blocks = &flags;
     const auto r = raster::execute(t, batch, eo);
     REQUIRE(r.ok());
     CHECK(r.value()[0] > 30000);  // the query did cover the target
-    std::vector<std::uint8_t> want(16, 0);
-    want[0] = 1;
+    std::vector<std::uint64_t> want(16, 0);
+    want[0] = 0x070707;
     CHECK(flags == want);
 }
 
 // ExecuteOptions::clear_depth: each tile task fills its tile before drawing there. The reference is
 // the plain DepthTarget::clear before each batch; the tiled runs start from a target holding
 // unrelated values, so a tile left unfilled shows in the buffer and usually in the counts.
-TEST_CASE("clear_depth gives the buffer and counts of DepthTarget::clear before each batch, with and without written_tiles") {
+TEST_CASE("clear_depth gives the buffer and counts of DepthTarget::clear before each batch, with and without written_blocks") {
     const raster::DepthFormat formats[] = {raster::DepthFormat::D16, raster::DepthFormat::D24,
                                            raster::DepthFormat::D32F};
     raster_test::SplitMix64 rng(0xc1ea7);
     int scenes = 0;
-    std::size_t tiles_skipped = 0;  // tiles the written_tiles runs did not fill (not flagged)
+    std::size_t blocks_skipped = 0;  // blocks the written_blocks runs did not fill (not flagged) ...
+    std::size_t partial_tiles = 0;   // ... in tiles where others were filled
     for (int s = 0; s < 24; ++s) {
         raster_test::SceneOptions o;
         o.width = 40 + static_cast<int>(rng.next() % 200);  // 1 to 4 tiles per side, partial tiles
@@ -270,10 +285,10 @@ TEST_CASE("clear_depth gives the buffer and counts of DepthTarget::clear before 
                 auto t = raster::DepthTarget::create(o.width, o.height, format);
                 REQUIRE(t.ok());
                 for (auto& v : t.value().mutable_values()) v = static_cast<std::uint32_t>(rng.next()) & 0x3fffffffu;
-                std::vector<std::uint8_t> written;  // empty: resized, every tile flagged
+                std::vector<std::uint64_t> written;  // empty: resized, every block flagged
                 raster::ExecuteOptions eo{threads};
                 eo.clear_depth = clear_depth;
-                if (with_written) eo.written_tiles = &written;
+                if (with_written) eo.written_blocks = &written;
                 if (threads == 3) {
                     auto r = raster::execute_sequence(t.value(), seq, eo);
                     REQUIRE(r.ok());
@@ -283,8 +298,13 @@ TEST_CASE("clear_depth gives the buffer and counts of DepthTarget::clear before 
                         auto r = raster::execute(t.value(), *seq[k], eo);
                         REQUIRE(r.ok());
                         CHECK(r.value() == want[k]);
-                        if (with_written && k == 0)
-                            tiles_skipped += static_cast<std::size_t>(std::count(written.begin(), written.end(), 0));
+                        if (with_written && k < 2) {  // what the next call restores
+                            const int tiles_x = (o.width + 63) / 64;
+                            for (int y = 0; y < o.height; y += 8)
+                                for (int x = 0; x < o.width; x += 8)
+                                    blocks_skipped += block_flagged(written, tiles_x, x, y) ? 0 : 1;
+                            for (const std::uint64_t m : written) partial_tiles += m != 0 && m != ~std::uint64_t{0} ? 1 : 0;
+                        }
                     }
                 }
                 CHECK(std::equal(want_depth.begin(), want_depth.end(), t.value().values().begin(), t.value().values().end()));
@@ -293,7 +313,8 @@ TEST_CASE("clear_depth gives the buffer and counts of DepthTarget::clear before 
         ++scenes;
     }
     CHECK(scenes == 24);
-    CHECK(tiles_skipped > 0);  // the written_tiles runs did skip tiles that no draw wrote
+    CHECK(blocks_skipped > 0);  // the written_blocks runs did skip blocks that no draw wrote ...
+    CHECK(partial_tiles > 0);   // ... beside blocks they filled in the same tile
 }
 
 TEST_CASE("A non-finite clear_depth is an error naming it, and changes nothing") {

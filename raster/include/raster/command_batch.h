@@ -77,24 +77,26 @@ struct ExecuteOptions {
     // Results never depend on it.
     bool hierarchical_z = true;
     // When set (execute() only): one entry per kExecuteTileSize square tile of the target, row-major
-    // from the bottom left ((width + 63) / 64 per row); execute() sets to 1 the entries of the tiles
-    // where a draw with the depth mask on was rasterized (a superset of the pixels it wrote) and
-    // leaves the others as they are, so that a caller can restore only those tiles. Resized to the
-    // tile count (new entries 0) when its size differs.
-    std::vector<std::uint8_t>* written_tiles = nullptr;
+    // from the bottom left ((width + 63) / 64 per row), each a mask of the tile's 8 x 8 pixel
+    // blocks (kExecuteBlockSize): bit by * 8 + bx for the block bx blocks right of and by blocks up
+    // from the tile's bottom-left corner (bits of blocks past the target's edge mean nothing).
+    // execute() sets the bits of the blocks where a draw with the depth mask on passed the depth
+    // test (a superset of the pixels it wrote) and leaves the others as they are, so that a caller
+    // can restore only those blocks. Resized to the tile count (new entries 0) when its size differs.
+    std::vector<std::uint64_t>* written_blocks = nullptr;
     // When set, every batch runs on a target cleared to this depth: the same results and buffer as
     // DepthTarget::clear(*clear_depth) before each batch (execute_reference does exactly that).
     // The tiled executor fills each tile in the tile's own task, before its first draw there: in
     // parallel, and while the tile is in that core's cache (a separate DepthTarget::clear is one
-    // serial pass over the whole buffer). With written_tiles, only the tiles flagged there are
-    // filled, and their flags reset before the batch's draws set them again: the caller's promise
-    // that the other tiles hold this depth already, which execute() keeps from one call to the
-    // next when every call uses the same clear_depth. If written_tiles has to be resized, every
-    // tile is flagged (its content is unknown). Must be finite (values outside [0, 1] clamp, as
+    // serial pass over the whole buffer). With written_blocks, only the blocks flagged there are
+    // filled, and their bits reset before the batch's draws set them again: the caller's promise
+    // that the other blocks hold this depth already, which execute() keeps from one call to the
+    // next when every call uses the same clear_depth. If written_blocks has to be resized, every
+    // block is flagged (its content is unknown). Must be finite (values outside [0, 1] clamp, as
     // DepthTarget::clear).
     std::optional<double> clear_depth = std::nullopt;
     // When set, only the query results are wanted: a draw that no query can observe is skipped,
-    // and the target's content afterwards is unspecified (written_tiles still flags every tile a
+    // and the target's content afterwards is unspecified (written_blocks still flags every block a
     // draw wrote, so clear_depth's restoring stays exact). The results are the same bit for bit.
     // Skipped: a draw outside every query that writes no pixel a later query of its batch may
     // cover (or writes nothing); and, with clear_depth = 1, a GL-exact draw inside a query, with the
@@ -105,8 +107,9 @@ struct ExecuteOptions {
     bool queries_only = false;
 };
 
-// The side of execute()'s tiles (ExecuteOptions::written_tiles).
+// The side of execute()'s tiles and of the blocks of ExecuteOptions::written_blocks.
 inline constexpr int kExecuteTileSize = 64;
+inline constexpr int kExecuteBlockSize = 8;
 
 // True when allow_simd runs the GL-exact AVX2 kernel in this process: it was built (x86-64, GCC or
 // Clang), the CPU has AVX2 and FMA, and CULLIDE_RASTER_NO_SIMD is unset or 0. For reports such as
