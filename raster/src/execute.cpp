@@ -156,6 +156,12 @@ struct Draws {
     std::vector<std::uint32_t> query;   // per entry: its batch's query active at it, or kNoQuery
     std::vector<RasterRules> rules;     // per entry: its batch's rules
     std::vector<std::size_t> k0, k1;    // per entry: its part [k0, k1) of the command's index list
+    // Per entry: the pixels outside which it need not be drawn (queries_only: observed_draws' clip
+    // of a write outside every query), else the whole target.
+    std::vector<detail::PixelRect> clip;
+    // Per entry with a clip: its part in each row of tiles from the clip's first (tile_of(clip.y0)
+    // + i: spans[i], empty when x0 > x1); nullptr when the clip is the whole target.
+    std::vector<const detail::PixelRect*> spans;
     std::vector<std::size_t> first;     // per batch, and the total at the end
 };
 
@@ -198,9 +204,17 @@ struct ObservedUnit {
     std::size_t k0, k1;   // its part of the command's index list
 };
 // One batch's units in command order, and which of them run.
+// observed_draws' clips: none (every pixel may matter), and empty (no pixel does).
+constexpr detail::PixelRect kNoClip{-1, -1, -1, -1};
+constexpr detail::PixelRect kEmptyClip{1, 1, 0, 0};
 struct ObservedBatch {
     std::vector<ObservedUnit> units;
     std::vector<std::uint8_t> keep;
+    // Per unit, where a kept write matters: the box in pixels and its part per row of tiles (its
+    // entries in `spans` from span_first); `no_clip` when every pixel may.
+    std::vector<detail::PixelRect> clip;
+    std::vector<std::uint32_t> span_first;
+    std::vector<detail::PixelRect> spans;
 };
 
 // Flags over the cells, with a coarse level (8 x 8 cells) so that a large box costs a few coarse
@@ -228,6 +242,32 @@ class CellFlags {
             for (int x = r.x0; x <= r.x1; ++x)
                 if (fine_[static_cast<std::size_t>(y) * cx_ + static_cast<std::size_t>(x)]) return true;
         return false;
+    }
+    // The smallest box of cells holding every flagged cell of r (a coarse cell flagged `all`
+    // counts as all its cells); empty (x0 > x1) when there is none.
+    [[nodiscard]] DrawReach bounds_in(const DrawReach& r) const {
+        DrawReach b;
+        b.x0 = b.y0 = std::numeric_limits<int>::max();
+        b.x1 = b.y1 = -1;
+        const auto extend = [&](int x0, int y0, int x1, int y1) {
+            b.x0 = std::min(b.x0, x0), b.y0 = std::min(b.y0, y0);
+            b.x1 = std::max(b.x1, x1), b.y1 = std::max(b.y1, y1);
+        };
+        for (int y = r.y0 >> 3; y <= r.y1 >> 3; ++y)
+            for (int x = r.x0 >> 3; x <= r.x1 >> 3; ++x) {
+                const std::size_t c = coarse(x, y);
+                if (!some_[c] && !all_[c]) continue;
+                const int fx0 = std::max(r.x0, x * 8), fx1 = std::min(r.x1, x * 8 + 7);
+                const int fy0 = std::max(r.y0, y * 8), fy1 = std::min(r.y1, y * 8 + 7);
+                if (all_[c]) {
+                    extend(fx0, fy0, fx1, fy1);
+                    continue;
+                }
+                for (int fy = fy0; fy <= fy1; ++fy)
+                    for (int fx = fx0; fx <= fx1; ++fx)
+                        if (fine_[static_cast<std::size_t>(fy) * cx_ + static_cast<std::size_t>(fx)]) extend(fx, fy, fx, fy);
+            }
+        return b;
     }
     void mark(const DrawReach& r) {
         const bool large = (r.x1 - r.x0 + 1) * (r.y1 - r.y0 + 1) > kSmall;
@@ -314,6 +354,14 @@ void observed_draws(const DepthTarget& target, const detail::CellGrid& grid, con
     const std::size_t n_units = ob.units.size();
     reach.resize(n_units);
     ob.keep.assign(n_units, 0);
+    ob.clip.assign(n_units, kNoClip);
+    ob.span_first.assign(n_units, 0);
+    ob.spans.clear();
+    // Cells to pixels: a cell's first pixel, and its last cut to the target.
+    const int shift = grid.shift;
+    const auto first_px = [&](int cell) { return cell << shift; };
+    const auto last_px = [&](int cell, int last) { return std::min(((cell + 1) << shift) - 1, last); };
+    const int last_x = target.width() - 1, last_y = target.height() - 1;
     constexpr std::size_t kReachChunk = 256;
     detail::parallel_for(threads, (n_units + kReachChunk - 1) / kReachChunk, [&](std::size_t chunk) {
         const std::size_t end = std::min(n_units, (chunk + 1) * kReachChunk);
@@ -325,6 +373,31 @@ void observed_draws(const DepthTarget& target, const detail::CellGrid& grid, con
         if (r.x0 > r.x1 || r.y0 > r.y1) continue;  // no pixel
         const bool counted = ob.units[u].query != kNoQuery;
         ob.keep[u] = counted || (cmds[ob.units[u].cmd].state.depth_write && read.any(r)) ? 1 : 0;
+        // A kept write outside every query: only its pixels in cells that later queries read
+        // matter, so it is drawn within the box of those cells (exact: the other pixels' stored
+        // depth is never read again; the target's final content is unspecified). A write inside a
+        // query is drawn whole (its count is the query's).
+        if (!counted && ob.keep[u]) {
+            // Its box of read cells, then that box's part in each row of tiles (at 1024^2 a row of
+            // tiles is a row of CellFlags' coarse cells): the clip follows the reading queries
+            // more closely than one box around them (leaves / cullide: a third fewer cells).
+            const DrawReach b = read.bounds_in(r);
+            if (b.x0 > b.x1) {
+                ob.clip[u] = kEmptyClip;
+                continue;
+            }
+            const detail::PixelRect box{first_px(b.x0), first_px(b.y0), last_px(b.x1, last_x), last_px(b.y1, last_y)};
+            ob.clip[u] = box;
+            ob.span_first[u] = static_cast<std::uint32_t>(ob.spans.size());
+            for (int ty = box.y0 / kTileSize; ty <= box.y1 / kTileSize; ++ty) {
+                const int py0 = std::max(box.y0, ty * kTileSize), py1 = std::min(box.y1, ty * kTileSize + kTileSize - 1);
+                DrawReach band = b;
+                band.y0 = py0 >> shift, band.y1 = py1 >> shift;
+                const DrawReach sb = read.bounds_in(band);
+                ob.spans.push_back(sb.x0 > sb.x1 ? kEmptyClip
+                                                 : detail::PixelRect{first_px(sb.x0), py0, last_px(sb.x1, last_x), py1});
+            }
+        }
         if (counted) read.mark(r);
     }
     if (!cleared_to_one) return;
@@ -373,10 +446,14 @@ void draws(std::span<const CommandBatch* const> batches, int threads, Draws& d, 
     d.rules.clear();
     d.k0.clear();
     d.k1.clear();
+    d.clip.clear();
+    d.spans.clear();
     d.first.clear();
     // Part [u0, u1) of command i's index list as one entry, or with several threads a big GL-exact
     // part as pieces of kFrontEndPiece triangles.
-    const auto add = [&](const CommandBatch& batch, std::size_t i, std::uint32_t query, std::size_t u0, std::size_t u1) {
+    const detail::PixelRect whole{0, 0, target.width() - 1, target.height() - 1};
+    const auto add = [&](const CommandBatch& batch, std::size_t i, std::uint32_t query, std::size_t u0, std::size_t u1,
+                         const detail::PixelRect& clip, const detail::PixelRect* spans) {
         const Command& c = batch.commands()[i];
         const bool split = threads > 1 && c.state.mode == RasterMode::GLExact && !c.double_input &&
                            u1 - u0 > 3 * kFrontEndPiece;
@@ -387,6 +464,8 @@ void draws(std::span<const CommandBatch* const> batches, int threads, Draws& d, 
             d.rules.push_back(batch.rules());
             d.k0.push_back(k);
             d.k1.push_back(split ? std::min(u1, k + 3 * kFrontEndPiece) : u1);
+            d.clip.push_back(clip);
+            d.spans.push_back(spans);
         }
     };
     for (std::size_t b = 0; b < batches.size(); ++b) {
@@ -394,8 +473,16 @@ void draws(std::span<const CommandBatch* const> batches, int threads, Draws& d, 
         d.first.push_back(d.cmd.size());
         if (options.queries_only) {  // the kept units (observed_draws)
             const ObservedBatch& ob = observed[b];
-            for (std::size_t u = 0; u < ob.units.size(); ++u)
-                if (ob.keep[u]) add(batch, ob.units[u].cmd, ob.units[u].query, ob.units[u].k0, ob.units[u].k1);
+            for (std::size_t u = 0; u < ob.units.size(); ++u) {
+                if (!ob.keep[u]) continue;
+                // An empty clip (the coarse test kept the write, no read cell is in its box): not
+                // drawn at all.
+                const detail::PixelRect& c = ob.clip[u];
+                if (c.x0 > c.x1) continue;
+                const bool clipped = c.x0 != kNoClip.x0;
+                add(batch, ob.units[u].cmd, ob.units[u].query, ob.units[u].k0, ob.units[u].k1, clipped ? c : whole,
+                    clipped ? ob.spans.data() + ob.span_first[u] : nullptr);
+            }
             continue;
         }
         const auto& cmds = batch.commands();
@@ -407,7 +494,7 @@ void draws(std::span<const CommandBatch* const> batches, int threads, Draws& d, 
                 active = kNoQuery;
             } else {
                 const Command& c = cmds[i];
-                add(batch, i, active, 0, c.double_input ? c.mesh_d.indices.size() : c.mesh.indices.size());
+                add(batch, i, active, 0, c.double_input ? c.mesh_d.indices.size() : c.mesh.indices.size(), whole, nullptr);
             }
         }
     }
@@ -554,7 +641,7 @@ struct Ref {
 // Binning: each tile lists the triangles overlapping it, in command order. In parallel over bands
 // of tile rows: each band walks every triangle in command order and fills only its own tiles, so
 // every bin is the same list for any thread count.
-void bin(const SetupDraws& setup, std::size_t d0, std::size_t d1, const Tiles& tiles, int threads,
+void bin(const SetupDraws& setup, const Draws& draws, std::size_t d0, std::size_t d1, const Tiles& tiles, int threads,
          std::vector<std::vector<Ref>>& bins) {
     reset_lists(bins, tiles.count());
     const int bands = threads > 1 ? std::min(threads, tiles.y) : 1;
@@ -568,25 +655,40 @@ void bin(const SetupDraws& setup, std::size_t d0, std::size_t d1, const Tiles& t
         // The tile of a pixel coordinate. Setup's boxes lie inside the target (>= 0), so an unsigned
         // shift is the division, without the signed one's fix-up on every triangle.
         const auto tile_of = [](int p) { return static_cast<int>(static_cast<unsigned>(p) / unsigned{kTileSize}); };
+        // A draw's tiles lie in those of its clip (Draws::clip): [cx0, cx1] x [cy0, cy1], and in
+        // each row of tiles in those of its part there (Draws::spans).
+        int cx0 = 0, cy0 = 0, cx1 = 0, cy1 = 0;
+        const detail::PixelRect* spans = nullptr;
         const auto bin_box = [&](std::size_t d, std::size_t t, int bx0, int by0, int bx1, int by1) {
-            for (int ty = std::max(tile_of(by0), band_ty0); ty <= std::min(tile_of(by1), band_ty1); ++ty)
-                for (int tx = tile_of(bx0); tx <= tile_of(bx1); ++tx) add(d, t, tx, ty);
+            for (int ty = std::max({tile_of(by0), band_ty0, cy0}); ty <= std::min({tile_of(by1), band_ty1, cy1}); ++ty)
+                for (int tx = std::max(tile_of(bx0), cx0); tx <= std::min(tile_of(bx1), cx1); ++tx) add(d, t, tx, ty);
         };
         // Draw d's GL-exact triangles into this band's tiles; with Cull, without those of the
         // facing the draw culls (share_setup left its culling to binning: CullFace::Front drops
         // front-facing triangles, CullFace::Back back-facing ones). A template, so that draws
         // without it keep a loop with no test (the test cost 0.6% of a cullide frame's instructions).
-        const auto bin_list = [&]<bool Cull>(std::size_t d, const std::vector<detail::SetupTri>& tris, bool drop_front) {
+        // With Clip, only the tiles of the draw's clip; a template too (most draws have none).
+        const auto bin_list = [&]<bool Cull, bool Clip>(std::size_t d, const std::vector<detail::SetupTri>& tris,
+                                                        bool drop_front) {
             for (std::size_t t = 0; t < tris.size(); ++t) {
                 const auto& tri = tris[t];
                 if constexpr (Cull) {
                     if (tri.front == drop_front) continue;
                 }
-                const int tile_y0 = tile_of(tri.y0), tile_y1 = tile_of(tri.y1);
+                int tile_y0 = tile_of(tri.y0), tile_y1 = tile_of(tri.y1);
+                int tx0 = tile_of(tri.x0), tx1 = tile_of(tri.x1);
+                if constexpr (Clip) {
+                    tile_y0 = std::max(tile_y0, cy0), tile_y1 = std::min(tile_y1, cy1);
+                    tx0 = std::max(tx0, cx0), tx1 = std::min(tx1, cx1);
+                    if (tx0 > tx1) continue;
+                }
                 const int ty0 = std::max(tile_y0, band_ty0), ty1 = std::min(tile_y1, band_ty1);
                 if (ty0 > ty1) continue;
-                const int tx0 = tile_of(tri.x0), tx1 = tile_of(tri.x1);
                 if (tile_y0 == tile_y1 && tx0 == tx1) {  // one tile (most triangles at CULLIDE's sizes)
+                    if constexpr (Clip) {
+                        const detail::PixelRect& sp = spans[tile_y0 - cy0];
+                        if (sp.x0 > sp.x1 || tx0 < tile_of(sp.x0) || tx0 > tile_of(sp.x1)) continue;
+                    }
                     add(d, t, tx0, tile_y0);
                     continue;
                 }
@@ -595,8 +697,14 @@ void bin(const SetupDraws& setup, std::size_t d0, std::size_t d1, const Tiles& t
                 // corner test of detail::rect_outside with the row part set once per row of tiles).
                 detail::RectReject reject(tri);
                 for (int ty = ty0; ty <= ty1; ++ty) {
+                    int row_tx0 = tx0, row_tx1 = tx1;
+                    if constexpr (Clip) {
+                        const detail::PixelRect& sp = spans[ty - cy0];
+                        if (sp.x0 > sp.x1) continue;
+                        row_tx0 = std::max(tx0, tile_of(sp.x0)), row_tx1 = std::min(tx1, tile_of(sp.x1));
+                    }
                     reject.set_rows(std::max(tri.y0, ty * kTileSize), std::min(tri.y1, ty * kTileSize + kTileSize - 1));
-                    for (int tx = tx0; tx <= tx1; ++tx) {
+                    for (int tx = row_tx0; tx <= row_tx1; ++tx) {
                         const int rx0 = std::max(tri.x0, tx * kTileSize);
                         const int rx1 = std::min(tri.x1, tx * kTileSize + kTileSize - 1);
                         if (!reject.outside(rx0, rx1)) add(d, t, tx, ty);
@@ -605,12 +713,20 @@ void bin(const SetupDraws& setup, std::size_t d0, std::size_t d1, const Tiles& t
             }
         };
         for (std::size_t d = d0; d < d1; ++d) {
+            const detail::PixelRect& clip = draws.clip[d];
+            cx0 = tile_of(clip.x0), cy0 = tile_of(clip.y0), cx1 = tile_of(clip.x1), cy1 = tile_of(clip.y1);
+            spans = draws.spans[d];
             const auto& tris = setup.tris_of(d);
             const CullFace cull = setup.bin_cull[d];
-            if (cull == CullFace::None)
-                bin_list.template operator()<false>(d, tris, false);
+            const bool clipped = spans != nullptr;
+            if (cull == CullFace::None && !clipped)
+                bin_list.template operator()<false, false>(d, tris, false);
+            else if (cull == CullFace::None)
+                bin_list.template operator()<false, true>(d, tris, false);
+            else if (!clipped)
+                bin_list.template operator()<true, false>(d, tris, cull == CullFace::Front);
             else
-                bin_list.template operator()<true>(d, tris, cull == CullFace::Front);
+                bin_list.template operator()<true, true>(d, tris, cull == CullFace::Front);
             for (std::size_t t = 0; t < setup.bounds[d].size(); ++t) {
                 const auto& tri = setup.bounds[d][t];
                 bin_box(d, t, tri.x0, tri.y0, tri.x1, tri.y1);
@@ -629,6 +745,10 @@ struct DrawInfo {
     bool exact_bounds;             // RasterMode::ExactBounds
     bool write;                    // depth mask on
     bool any_only;                 // an any-samples query with the mask off (see shade)
+    // Draws::spans: pixels outside them are not drawn (nullptr: no clip); spans[ty - span_ty0] for
+    // the row of tiles ty.
+    const detail::PixelRect* spans;
+    int span_ty0;
 };
 
 // For the draws [d0, d1) of `batch` (a sequence's batch k: d0 = first[k], d1 = first[k + 1]);
@@ -642,6 +762,8 @@ void draw_infos(const CommandBatch& batch, const Draws& draws, std::size_t d0, s
         const Command& c = *draws.cmd[d];
         DrawInfo& info = out[d];
         info.query = draws.query[d];
+        info.spans = draws.spans[d];
+        info.span_ty0 = draws.clip[d].y0 / kTileSize;
         info.exact_bounds = c.state.mode == RasterMode::ExactBounds;
         info.write = c.state.depth_write;
         info.any_only = info.query != kNoQuery && !c.state.depth_write &&
@@ -716,6 +838,14 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
     const auto clip_to_tile = [&](int bx0, int by0, int bx1, int by1) {
         return detail::PixelRect{std::max(x0, bx0), std::max(y0, by0), std::min(x1, bx1), std::min(y1, by1)};
     };
+    // A draw's clip (its part in this row of tiles: Draws::spans) on a rectangle of this tile;
+    // false when nothing is left.
+    const auto clip_draw = [ty](const DrawInfo& info, detail::PixelRect& r) __attribute__((always_inline)) {
+        if (info.spans == nullptr) return true;
+        const detail::PixelRect& c = info.spans[ty - info.span_ty0];
+        r = {std::max(r.x0, c.x0), std::max(r.y0, c.y0), std::min(r.x1, c.x1), std::min(r.y1, c.y1)};
+        return r.x0 <= r.x1 && r.y0 <= r.y1;
+    };
     const std::size_t tile_index = static_cast<std::size_t>(ty) * static_cast<std::size_t>((ctx.width + kTileSize - 1) / kTileSize) +
                                    static_cast<std::size_t>(tx);
     detail::HizTile* const hiz = ctx.hiz ? &ctx.hiz_tiles[tile_index] : nullptr;
@@ -758,9 +888,10 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
             const Command& c = *ctx.draws.cmd[r.draw];
             const detail::DepthState depth_state{ctx.format, c.state.depth_func, c.state.depth_write};
             const auto& tri = ctx.setup.bounds[r.draw][r.tri];
-            const detail::PixelRect rect = clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1);
+            detail::PixelRect rect = clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1);
+            if (!clip_draw(info, rect)) continue;
             passed = detail::bounds_rect(tri, ctx.setup.pool[r.draw].data(), depth_state, ctx.depth, rect);
-            if (c.state.depth_write && passed != 0) mark(rect);
+            if (written != nullptr && c.state.depth_write && passed != 0) mark(rect);
             if (hiz != nullptr && c.state.depth_write) hiz->valid = 0;  // its writes are not tracked
         } else {
             // Any-samples query with the mask off: once this query has a passing sample (in this
@@ -772,6 +903,7 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
                 continue;
             const detail::SetupTri& tri = info.tris[r.tri];
             detail::PixelRect rect = clip_to_tile(tri.x0, tri.y0, tri.x1, tri.y1);
+            if (!clip_draw(info, rect)) continue;
             // A triangle over several tiles: its part of this tile may be much smaller than the
             // box's (a thin triangle through a corner). Within one tile the box is already tight.
             // Exact: the kernel counts and writes the same on the shrunk rectangle.
@@ -779,7 +911,7 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
                 (rect.x1 - rect.x0 + 1) * (rect.y1 - rect.y0 + 1) >= kShrinkMinArea && !detail::shrink_rect(tri, rect))
                 continue;
             passed = info.kernel(tri, ctx.depth, rect, hiz, any_only);
-            if (info.write && passed != 0) mark(rect);
+            if (written != nullptr && info.write && passed != 0) mark(rect);
             if (any_only && passed != 0) ctx.answered[q].store(true, std::memory_order_relaxed);
         }
         if (q == kNoQuery || passed == 0) continue;
@@ -858,7 +990,7 @@ Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::spa
         if (k > 0 && between) between(k);
         const CommandBatch& batch = *batches[k];
         const std::size_t d0 = draw_list.first[k], d1 = draw_list.first[k + 1];
-        bin(setup, d0, d1, tiles, threads, scratch.bins);
+        bin(setup, draw_list, d0, d1, tiles, threads, scratch.bins);
         const std::vector<std::vector<Ref>>& bins = scratch.bins;
 
         // Back end: one task per tile.
