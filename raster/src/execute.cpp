@@ -799,7 +799,7 @@ struct ShadeContext {
 // of `clear_row` (kTileSize values). Each row part by memcpy (wide stores on any target; the element
 // loop of std::fill stored one value per instruction): the whole tile row by row when every block
 // is flagged, else each block row's runs of flagged blocks. A target of 4096^2 holds 64 MB and
-// raster_bench SmallTris writes about one block in six there: restoring only those is most of the
+// raster_bench SmallTris writes one block in 13 there: restoring only those is most of the
 // difference (docs/raster.md, session 16).
 void clear_blocks(detail::DepthRows depth, const std::uint32_t* clear_row, detail::PixelRect tile, std::uint64_t mask) {
     constexpr int B = kExecuteBlockSize;
