@@ -378,25 +378,33 @@ void observed_draws(const DepthTarget& target, const detail::CellGrid& grid, con
         // depth is never read again; the target's final content is unspecified). A write inside a
         // query is drawn whole (its count is the query's).
         if (!counted && ob.keep[u]) {
-            // Its box of read cells, then that box's part in each row of tiles (at 1024^2 a row of
+            // Per row of tiles of its box, the box of the read cells there (at 1024^2 a row of
             // tiles is a row of CellFlags' coarse cells): the clip follows the reading queries
-            // more closely than one box around them (leaves / cullide: a third fewer cells).
-            const DrawReach b = read.bounds_in(r);
-            if (b.x0 > b.x1) {
-                ob.clip[u] = kEmptyClip;
-                continue;
-            }
-            const detail::PixelRect box{first_px(b.x0), first_px(b.y0), last_px(b.x1, last_x), last_px(b.y1, last_y)};
-            ob.clip[u] = box;
-            ob.span_first[u] = static_cast<std::uint32_t>(ob.spans.size());
-            for (int ty = box.y0 / kTileSize; ty <= box.y1 / kTileSize; ++ty) {
-                const int py0 = std::max(box.y0, ty * kTileSize), py1 = std::min(box.y1, ty * kTileSize + kTileSize - 1);
-                DrawReach band = b;
-                band.y0 = py0 >> shift, band.y1 = py1 >> shift;
+            // more closely than one box around them (leaves / cullide: a third fewer cells). The
+            // clip's box is their union; rows before the first and after the last read cell are
+            // left out.
+            const std::size_t first = ob.spans.size();
+            detail::PixelRect box = kEmptyClip;
+            std::size_t last_used = first;  // one past the last row of tiles with a read cell
+            const int ry0 = first_px(r.y0), ry1 = last_px(r.y1, last_y);
+            for (int ty = ry0 / kTileSize; ty <= ry1 / kTileSize; ++ty) {
+                DrawReach band = r;
+                band.y0 = std::max(ry0, ty * kTileSize) >> shift;
+                band.y1 = std::min(ry1, ty * kTileSize + kTileSize - 1) >> shift;
                 const DrawReach sb = read.bounds_in(band);
-                ob.spans.push_back(sb.x0 > sb.x1 ? kEmptyClip
-                                                 : detail::PixelRect{first_px(sb.x0), py0, last_px(sb.x1, last_x), py1});
+                if (sb.x0 > sb.x1) {
+                    if (ob.spans.size() > first) ob.spans.push_back(kEmptyClip);  // none before the first
+                    continue;
+                }
+                const detail::PixelRect span{first_px(sb.x0), first_px(sb.y0), last_px(sb.x1, last_x), last_px(sb.y1, last_y)};
+                if (ob.spans.size() == first) box = span;
+                box = {std::min(box.x0, span.x0), box.y0, std::max(box.x1, span.x1), span.y1};
+                ob.spans.push_back(span);
+                last_used = ob.spans.size();
             }
+            ob.spans.resize(last_used);  // none after the last
+            ob.clip[u] = box;  // kEmptyClip when no read cell is in the box: not drawn
+            ob.span_first[u] = static_cast<std::uint32_t>(first);
         }
         if (counted) read.mark(r);
     }
@@ -797,18 +805,13 @@ struct ShadeContext {
 
 // Fills the blocks of `tile` flagged in `mask` (ExecuteOptions::written_blocks' layout) with copies
 // of `clear_row` (kTileSize values). Each row part by memcpy (wide stores on any target; the element
-// loop of std::fill stored one value per instruction): the whole tile row by row when every block
-// is flagged, else each block row's runs of flagged blocks. A target of 4096^2 holds 64 MB and
+// loop of std::fill stored one value per instruction): each block row's runs of flagged blocks (a
+// whole row of the tile when every block is flagged). A target of 4096^2 holds 64 MB and
 // raster_bench SmallTris writes one block in 13 there: restoring only those is most of the
 // difference (docs/raster.md, session 16).
 void clear_blocks(detail::DepthRows depth, const std::uint32_t* clear_row, detail::PixelRect tile, std::uint64_t mask) {
     constexpr int B = kExecuteBlockSize;
     static_assert(kTileSize == 8 * B, "one bit per block of a tile in a 64-bit mask");
-    if (mask == ~std::uint64_t{0}) {
-        for (int y = tile.y0; y <= tile.y1; ++y)
-            std::memcpy(depth.row(y) + tile.x0, clear_row, static_cast<std::size_t>(tile.x1 - tile.x0 + 1) * sizeof(std::uint32_t));
-        return;
-    }
     for (int by = 0; mask != 0; ++by, mask >>= 8) {
         unsigned bits = static_cast<unsigned>(mask & 0xffu);
         const int ya = tile.y0 + by * B;
