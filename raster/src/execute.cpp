@@ -22,6 +22,10 @@
 #include "raster/command_batch.h"
 #include "validate.h"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 
 namespace raster {
 namespace {
@@ -303,14 +307,35 @@ DrawReach draw_reach(const DepthTarget& target, RasterRules rules, const Command
     if (k1 == k0) return r;
     constexpr float kInf = __builtin_inff();
     float x0 = kInf, x1 = -kInf, y0 = kInf, y1 = -kInf, z1 = -kInf;
+    const Float4* verts = c.mesh.vertices.data();
+    const std::uint32_t* idx = c.mesh.indices.data();
+#if defined(__SSE2__)
+    // All four coordinates per vertex in one register: a min and a max per index (the scalar loop
+    // was 20 instructions per index: 9% of a 2-thread cloth / cullide frame, perf). The vertices
+    // were validated finite, so minps / maxps with the running value second are std::min / std::max
+    // with it first (ties keep it), and every w is 1 exactly when the least and the greatest are.
+    static_assert(sizeof(Float4) == 4 * sizeof(float), "a vertex is read as 4 floats");
+    __m128 lo = _mm_set1_ps(kInf), hi = _mm_set1_ps(-kInf);
+    for (std::size_t k = k0; k < k1; ++k) {
+        const __m128 v = _mm_loadu_ps(&verts[idx[k]].x);
+        lo = _mm_min_ps(v, lo);
+        hi = _mm_max_ps(v, hi);
+    }
+    alignas(16) float l[4], h[4];
+    _mm_store_ps(l, lo);
+    _mm_store_ps(h, hi);
+    const bool ortho = l[3] == 1.0f && h[3] == 1.0f;
+    x0 = l[0], y0 = l[1], x1 = h[0], y1 = h[1], z1 = h[2];
+#else
     bool ortho = true;
     for (std::size_t k = k0; k < k1; ++k) {
-        const Float4& v = c.mesh.vertices[c.mesh.indices[k]];
+        const Float4& v = verts[idx[k]];
         ortho = ortho && v.w == 1.0f;
         x0 = std::min(x0, v.x), x1 = std::max(x1, v.x);
         y0 = std::min(y0, v.y), y1 = std::max(y1, v.y);
         z1 = std::max(z1, v.z);
     }
+#endif
     if (!ortho) return whole();
     const Viewport vp = c.state.viewport ? *c.state.viewport : Viewport{0, 0, target.width(), target.height()};
     const double hw = vp.width * 0.5, hh = vp.height * 0.5;
