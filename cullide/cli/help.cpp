@@ -281,8 +281,8 @@ std::string version_text() {
 #else
     const char* tbb = "oneTBB off (serial)";
 #endif
-    return std::string("cullide ") + version() + "\nconfiguration: " + tbb + ", AVX2 raster kernel " +
-           (raster::simd_kernel_active() ? "on" : "off (portable kernel)") + "\n";
+    return std::string("cullide ") + version() + "\nconfiguration: " + tbb + ", raster kernel " +
+           raster::simd_kernel_name() + "\n";
 }
 
 }  // namespace cullide::cli

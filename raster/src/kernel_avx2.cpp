@@ -86,11 +86,6 @@ inline unsigned lanes(__m256i m) {
     return static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(m)));
 }
 
-// Edge i at pixel centre (px, py), exactly as the scalar span solver sees it.
-inline std::int64_t edge_at(const SetupTri& t, int i, int px, int py) {
-    return t.c[i] - t.dcdx[i] * 256 * px + t.dcdy[i] * 256 * py;
-}
-
 // The depth plane's coefficients in every lane, read from the SetupTri once per rectangle (a
 // store through __m256i may alias anything, so loops that read them from `t` reload them after
 // every store).
@@ -135,28 +130,6 @@ inline unsigned chunk8(const Plane8& plane, std::uint32_t* row, int px, __m256 f
     }
     return bits;
 }
-
-// floor(n(py) / d) for successive rows py, n(py) = n(y0) + step * (py - y0), d > 0: quotient and
-// remainder stepped by the step's own quotient and remainder (the integer walk of Bresenham's
-// line algorithm), so a row costs adds and one compare instead of a 64-bit division; the same
-// integers as floor_div on every row.
-struct EdgeWalk {
-    std::int64_t q, r, dq, dr, d;  // n = q d + r, 0 <= r < d; step = dq d + dr, 0 <= dr < d
-    void init(std::int64_t n, std::int64_t step, std::int64_t div) {
-        d = div;
-        q = avx2::floor_div(n, d);
-        r = n - q * d;
-        dq = avx2::floor_div(step, d);
-        dr = step - dq * d;
-    }
-    void next() {  // without a branch: the wrap-around follows the edge's slope, which no predictor knows
-        q += dq;
-        r += dr;
-        const std::int64_t wrap = r >= d ? 1 : 0;
-        q += wrap;
-        r -= d & -wrap;
-    }
-};
 
 constexpr int kNarrow = 16;  // rectangles narrower than this take the per-chunk edge path when it fits
 
@@ -212,88 +185,24 @@ std::uint64_t narrow_rows(const SetupTri& t, DepthRows depth, PixelRect rect, co
 
 template <DepthFormat Fmt, DepthFunc F, bool Write>
 std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, bool stop_at_first) {
-    const int rx0 = rect.x0, ry0 = rect.y0, rx1 = rect.x1, ry1 = rect.y1;
+    const int rx0 = rect.x0, rx1 = rect.x1;
     const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     std::uint64_t passed = 0;
     if (rx1 - rx0 < kNarrow) {
-        // Narrow rectangles (small triangles, box edges): coverage per 8 pixels from the three edge
-        // functions in 32-bit lanes, when every value they take over the rectangle (padded to whole
-        // chunks of 8) fits: |e| <= |e(rx0, ry0)| + |x step| * (width + 7) + |y step| * (height - 1)
-        // < 2^31. Exact: the same integers as the 64-bit span solver, without its divisions.
-        // Setup's per-triangle flag (SetupTri::fits32) covers every rectangle inside the box; the
-        // rectangle's own bound is computed only for triangles without it.
         std::int64_t e_row[3], sx[3], sy[3];
-        #pragma GCC unroll 3
-        for (int i = 0; i < 3; ++i) {
-            e_row[i] = edge_at(t, i, rx0, ry0);
-            sx[i] = t.dcdx[i] * 256;
-            sy[i] = t.dcdy[i] * 256;
-        }
-        bool fits = t.fits32;
-        if (!fits) {
-            fits = true;
-            #pragma GCC unroll 3
-            for (int i = 0; i < 3; ++i) {
-                const std::int64_t bound =
-                    std::abs(e_row[i]) + std::abs(sx[i]) * (rx1 - rx0 + 8) + std::abs(sy[i]) * (ry1 - ry0);
-                fits = fits && bound < (std::int64_t{1} << 31);
-            }
-        }
-        if (fits) {
+        if (avx2::narrow_lanes_fit(t, rect, e_row, sx, sy)) {
             return rx1 - rx0 < 8 ? narrow_rows<1, Fmt, F, Write>(t, depth, rect, e_row, sx, sy, stop_at_first)
                                  : narrow_rows<2, Fmt, F, Write>(t, depth, rect, e_row, sx, sy, stop_at_first);
         }
     }
-
-    // Block-level classification of the rectangle against each edge (corner centres).
-    int edges[3];
-    int n_edges = 0;
-#pragma GCC unroll 3
-    for (int i = 0; i < 3; ++i) {
-        const std::int64_t e00 = edge_at(t, i, rx0, ry0), e10 = edge_at(t, i, rx1, ry0);
-        const std::int64_t e01 = edge_at(t, i, rx0, ry1), e11 = edge_at(t, i, rx1, ry1);
-        if (e00 <= 0 && e10 <= 0 && e01 <= 0 && e11 <= 0) return 0;  // trivial reject
-        if (!(e00 > 0 && e10 > 0 && e01 > 0 && e11 > 0)) edges[n_edges++] = i;  // else trivially inside
-    }
-
-    // Otherwise each row's span from the 64-bit edge functions: the scalar solver's floor
-    // divisions (edge_span of raster_kernel.inc), stepped from row to row without dividing
-    // (EdgeWalk). An edge constant along rows (dcdx = 0) bounds the rows instead, exactly.
-    EdgeWalk upper[3], lower[3];  // bounds on the last / first covered column
-    int n_upper = 0, n_lower = 0;
-    int y0 = ry0, y1 = ry1;
-    for (int k = 0; k < n_edges; ++k) {
-        const int i = edges[k];
-        const std::int64_t s = t.dcdx[i] * 256, sy = t.dcdy[i] * 256;
-        if (s != 0) continue;
-        if (sy > 0) {
-            y0 = static_cast<int>(std::max<std::int64_t>(y0, avx2::floor_div(-t.c[i], sy) + 1));
-        } else if (sy < 0) {
-            y1 = static_cast<int>(std::min<std::int64_t>(y1, avx2::floor_div(t.c[i] - 1, -sy)));
-        } else if (t.c[i] <= 0) {
-            return 0;
-        }
-    }
-    for (int k = 0; k < n_edges; ++k) {
-        const int i = edges[k];
-        const std::int64_t s = t.dcdx[i] * 256, sy = t.dcdy[i] * 256;
-        const std::int64_t base = t.c[i] + sy * y0;  // e(px) = base - s px on the row y0
-        if (s > 0) upper[n_upper++].init(base - 1, sy, s);  // px <= floor((base - 1) / s)
-        if (s < 0) lower[n_lower++].init(-base, -sy, -s);   // px >= floor(-base / -s) + 1
-    }
+    avx2::RowSpans spans;
+    if (!spans.init(t, rect)) return 0;
     const __m256i all = _mm256_set1_epi32(-1);
     const __m256 eight = _mm256_set1_ps(8.0f);
     const Plane8 plane(t);
-    for (int py = y0; py <= y1; ++py) {
-        std::int64_t lo = rx0, hi = rx1;
-        for (int k = 0; k < n_upper; ++k) {
-            hi = std::min(hi, upper[k].q);
-            upper[k].next();
-        }
-        for (int k = 0; k < n_lower; ++k) {
-            lo = std::max(lo, lower[k].q + 1);
-            lower[k].next();
-        }
+    for (int py = static_cast<int>(spans.y0); py <= spans.y1; ++py) {
+        std::int64_t lo, hi;
+        spans.next(rx0, rx1, lo, hi);
         if (lo > hi) continue;
         std::uint32_t* row = depth.row(py);
         const __m256 fy = _mm256_set1_ps(static_cast<float>(py));
@@ -352,6 +261,10 @@ struct Avx2Kernel {  // the scalar kernel, built in this file's namespace
 };
 #endif
 }  // namespace
+
+void stored_bounds_avx2(DepthRows d, int x0, int y0, int x1, int y1, std::uint32_t& lo, std::uint32_t& hi) {
+    Avx2Kernel::scan(d, x0, y0, x1, y1, lo, hi);
+}
 
 RectKernel select_rect_kernel_avx2(const DepthState& state, bool hiz) {
     return avx2::select_rect_kernel_with<Avx2Kernel>(state, hiz);

@@ -95,8 +95,9 @@ inline void setup_range(const FrontEndParams& params, std::span<const Float4> ve
 
 // Rasterizes `tri` over `rect` (inside the target and the triangle's box) into `depth` with the
 // draw's depth `state`. Returns the samples that passed.
-// allow_simd picks the 8-wide AVX2+FMA kernel when the CPU has it and the environment variable
-// CULLIDE_RASTER_NO_SIMD is not set to a non-empty value other than "0" (bit-identical results).
+// allow_simd picks the 16-wide AVX-512 kernel or else the 8-wide AVX2+FMA kernel when the CPU has
+// it and the environment variable CULLIDE_RASTER_NO_SIMD is not set to a non-empty value other than
+// "0" (CULLIDE_RASTER_NO_AVX512 likewise keeps AVX2); bit-identical results.
 // stop_at_first: the caller only needs to know whether any sample passes (an any-samples query
 // with the depth mask off): the kernel may return any count >= 1 as soon as one sample passed.
 std::uint64_t raster_rect(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
@@ -116,6 +117,15 @@ inline std::uint64_t raster_rect_avx2(const SetupTri& tri, DepthFormat format, D
                                       std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1,
                                       bool stop_at_first) {
     return raster_rect_avx2(tri, {format, func, write}, {depth, stride}, {rx0, ry0, rx1, ry1}, stop_at_first);
+}
+// The 16-wide AVX-512 kernel (kernel_avx512.cpp), chosen before the AVX2 one where the CPU has
+// AVX-512F and VL and CULLIDE_RASTER_NO_AVX512 is not set to a non-empty value other than "0".
+std::uint64_t raster_rect_avx512(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
+                                 bool stop_at_first);
+inline std::uint64_t raster_rect_avx512(const SetupTri& tri, DepthFormat format, DepthFunc func, bool write,
+                                        std::uint32_t* depth, int stride, int rx0, int ry0, int rx1, int ry1,
+                                        bool stop_at_first) {
+    return raster_rect_avx512(tri, {format, func, write}, {depth, stride}, {rx0, ry0, rx1, ry1}, stop_at_first);
 }
 // Hierarchical Z (issue #17): bounds of the stored depth per 8 x 8 pixel block of one 64 x 64 tile,
 // so that a query triangle (depth mask off) whose depth test certainly fails over a whole block
@@ -158,6 +168,8 @@ std::uint64_t raster_rect_hiz_portable(const SetupTri& tri, const DepthState& st
                                        PixelRect rect, HizTile& hiz, bool stop_at_first);
 std::uint64_t raster_rect_hiz_avx2(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
                                    HizTile& hiz, bool stop_at_first);
+std::uint64_t raster_rect_hiz_avx512(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
+                                     HizTile& hiz, bool stop_at_first);
 
 // The kernel that raster_rect (hiz false) or raster_rect_hiz (hiz true) runs for a draw's depth
 // state, resolved once: the tiled executor picks it per draw instead of dispatching per rectangle
@@ -168,9 +180,17 @@ using RectKernel = std::uint64_t (*)(const SetupTri& tri, DepthRows depth, Pixel
 RectKernel select_rect_kernel(const DepthState& state, bool allow_simd, bool hiz);
 RectKernel select_rect_kernel_portable(const DepthState& state, bool hiz);
 RectKernel select_rect_kernel_avx2(const DepthState& state, bool hiz);
+RectKernel select_rect_kernel_avx512(const DepthState& state, bool hiz);
 
 // True when the CPU has AVX2 and FMA and this build has the AVX2 kernel (x86-64 GCC/Clang).
 bool kernel_avx2_available();
+// True when the CPU has AVX-512F, AVX-512VL, AVX2 and FMA and this build has the AVX-512 kernel.
+bool kernel_avx512_available();
+// False when CULLIDE_RASTER_NO_AVX512 keeps the AVX2 kernel where AVX-512 is available (read once).
+bool avx512_allowed_by_environment();
+// The HiZ block scan of the AVX2 kernel (8-pixel rows in one register; the scalar loop otherwise),
+// for the AVX-512 kernel's HiZ entry: the stored minimum and maximum of [x0, x1] x [y0, y1].
+void stored_bounds_avx2(DepthRows d, int x0, int y0, int x1, int y1, std::uint32_t& lo, std::uint32_t& hi);
 // False when CULLIDE_RASTER_NO_SIMD forces the portable kernel everywhere (read once).
 bool simd_allowed_by_environment();
 

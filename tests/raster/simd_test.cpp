@@ -59,9 +59,11 @@ detail::FrontEndParams whole_target(int w, int h) {
 
 }  // namespace
 
-TEST_CASE("AVX2 kernel == portable kernel on random triangles, rectangles and stored depths (every format, function, mask)") {
+TEST_CASE("AVX2 and AVX-512 kernels == portable kernel on random triangles, rectangles and stored depths (every format, function, mask)") {
     if (!detail::kernel_avx2_available())
         MESSAGE("no AVX2+FMA kernel on this CPU/build: comparing the fallback build with the portable one");
+    if (!detail::kernel_avx512_available())
+        MESSAGE("no AVX-512 kernel on this CPU/build: comparing its fallback build with the portable one");
     raster_test::SplitMix64 rng(0x5eed51u);
     const int sizes[][2] = {{64, 64}, {203, 131}, {257, 67}, {13, 9}};
     std::uint64_t total_passed = 0, compared = 0, rejected_rects = 0;
@@ -107,21 +109,29 @@ TEST_CASE("AVX2 kernel == portable kernel on random triangles, rectangles and st
                         detail::raster_rect_avx2(t, f, func, write, b.data(), w, rx0, ry0, rx1, ry1, false);
                     CHECK(na == nb);
                     REQUIRE(a == b);  // every depth value, including pixels outside the rectangle
-                    // Early exit: > 0 exactly when the full count is > 0, on both kernels.
-                    auto c = base, d = base;
+                    auto b16 = base;
+                    CHECK(na == detail::raster_rect_avx512(t, f, func, write, b16.data(), w, rx0, ry0, rx1, ry1, false));
+                    REQUIRE(a == b16);
+                    // Early exit: > 0 exactly when the full count is > 0, on every kernel.
+                    auto c = base, d = base, d16 = base;
                     const std::uint64_t sa = detail::raster_rect_portable(t, f, func, false, c.data(), w, rx0, ry0,
                                                                           rx1, ry1, true);
                     const std::uint64_t sb =
                         detail::raster_rect_avx2(t, f, func, false, d.data(), w, rx0, ry0, rx1, ry1, true);
+                    const std::uint64_t s16 =
+                        detail::raster_rect_avx512(t, f, func, false, d16.data(), w, rx0, ry0, rx1, ry1, true);
                     std::vector<std::uint32_t> e = base;
                     const std::uint64_t full =
                         detail::raster_rect_portable(t, f, func, false, e.data(), w, rx0, ry0, rx1, ry1, false);
                     CHECK((sa > 0) == (full > 0));
                     CHECK((sb > 0) == (full > 0));
+                    CHECK((s16 > 0) == (full > 0));
                     CHECK(sa <= full);
                     CHECK(sb <= full);
+                    CHECK(s16 <= full);
                     CHECK(c == base);
                     CHECK(d == base);
+                    CHECK(d16 == base);
                     total_passed += na;
                     ++compared;
                 }
@@ -323,7 +333,8 @@ TEST_CASE("row spans (AVX2 walk, portable division) and shrink_rect == the per-p
     for (const auto& sz : sizes) {
         const int w = sz[0], h = sz[1];
         detail::FrontEndParams p = whole_target(w, h);
-        std::vector<std::uint32_t> a(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), kSentinel), b = a;
+        std::vector<std::uint32_t> a(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), kSentinel), b = a,
+                                   c16 = a;
         for (int n = 0; n < 1500; ++n) {
             std::vector<detail::SetupTri> tris;
             raster::Float4 v[3];
@@ -372,10 +383,13 @@ TEST_CASE("row spans (AVX2 walk, portable division) and shrink_rect == the per-p
                                                                       a.data(), w, r.x0, r.y0, r.x1, r.y1, false);
                 const std::uint64_t nb = detail::raster_rect_avx2(t, DepthFormat::D24, DepthFunc::Always, true,
                                                                   b.data(), w, r.x0, r.y0, r.x1, r.y1, false);
+                const std::uint64_t n16 = detail::raster_rect_avx512(t, DepthFormat::D24, DepthFunc::Always, true,
+                                                                     c16.data(), w, r.x0, r.y0, r.x1, r.y1, false);
                 CAPTURE(w);
                 CAPTURE(n);
                 CHECK(na == want);
                 CHECK(nb == want);
+                CHECK(n16 == want);
                 detail::PixelRect s = r;
                 const bool live = detail::shrink_rect(t, s);
                 if (!live) {
@@ -398,9 +412,9 @@ TEST_CASE("row spans (AVX2 walk, portable division) and shrink_rect == the per-p
                         const std::size_t k = static_cast<std::size_t>(py) * static_cast<std::size_t>(w) +
                                               static_cast<std::size_t>(px);
                         const bool cov = covered_by_definition(t, px, py);
-                        same = same && (a[k] != kSentinel) == cov && (b[k] != kSentinel) == cov;
+                        same = same && (a[k] != kSentinel) == cov && (b[k] != kSentinel) == cov && c16[k] == a[k];
                         inside = inside && (!cov || (live && px >= s.x0 && px <= s.x1 && py >= s.y0 && py <= s.y1));
-                        a[k] = b[k] = kSentinel;
+                        a[k] = b[k] = c16[k] = kSentinel;
                     }
                 }
                 CHECK(same);
@@ -411,6 +425,7 @@ TEST_CASE("row spans (AVX2 walk, portable division) and shrink_rect == the per-p
         }
         CHECK(std::all_of(a.begin(), a.end(), [](std::uint32_t x) { return x == kSentinel; }));
         CHECK(std::all_of(b.begin(), b.end(), [](std::uint32_t x) { return x == kSentinel; }));
+        CHECK(std::all_of(c16.begin(), c16.end(), [](std::uint32_t x) { return x == kSentinel; }));
     }
     MESSAGE("rectangles: " << rects << ", covered pixels: " << covered_total << ", shrunk: " << shrunk
                            << ", shrunk to nothing: " << emptied);
@@ -429,7 +444,7 @@ TEST_CASE("kernels and shrink_rect on made-up edge functions that are -1, 0, 1 o
     raster_test::SplitMix64 rng(0xed6e5u);
     constexpr int W = 96, H = 80;
     constexpr std::uint32_t kSentinel = 0xffffffffu;
-    std::vector<std::uint32_t> a(W * H, kSentinel), b = a;
+    std::vector<std::uint32_t> a(W * H, kSentinel), b = a, c16 = a;
     std::uint64_t covered_total = 0, partial_rows = 0, emptied = 0;
     const auto slope = [&]() -> std::int64_t {
         switch (rng.below(4)) {
@@ -473,6 +488,8 @@ TEST_CASE("kernels and shrink_rect on made-up edge functions that are -1, 0, 1 o
                                            r.y1, false) == want);
         CHECK(detail::raster_rect_avx2(t, DepthFormat::D24, DepthFunc::Always, true, b.data(), W, r.x0, r.y0, r.x1,
                                        r.y1, false) == want);
+        CHECK(detail::raster_rect_avx512(t, DepthFormat::D24, DepthFunc::Always, true, c16.data(), W, r.x0, r.y0,
+                                         r.x1, r.y1, false) == want);
         detail::PixelRect s = r;
         const bool live = detail::shrink_rect(t, s);
         emptied += live ? 0u : 1u;
@@ -481,9 +498,9 @@ TEST_CASE("kernels and shrink_rect on made-up edge functions that are -1, 0, 1 o
             for (int px = r.x0; px <= r.x1; ++px) {
                 const std::size_t k = static_cast<std::size_t>(py * W + px);
                 const bool cov = covered_by_definition(t, px, py);
-                same = same && (a[k] != kSentinel) == cov && (b[k] != kSentinel) == cov;
+                same = same && (a[k] != kSentinel) == cov && (b[k] != kSentinel) == cov && c16[k] == a[k];
                 inside = inside && (!cov || (live && px >= s.x0 && px <= s.x1 && py >= s.y0 && py <= s.y1));
-                a[k] = b[k] = kSentinel;
+                a[k] = b[k] = c16[k] = kSentinel;
             }
         }
         CHECK(same);
@@ -499,12 +516,15 @@ TEST_CASE("kernels and shrink_rect on made-up edge functions that are -1, 0, 1 o
         const DepthFormat f = kFormats[rng.below(3)];
         const DepthFunc func = kFuncs[rng.below(8)];
         const bool write = rng.chance(50);
-        std::vector<std::uint32_t> c(W * H), d;
+        std::vector<std::uint32_t> c(W * H), d, e;
         for (auto& x : c) x = random_stored(rng, f, std::clamp(t.z0, 0.0f, 1.0f));
         d = c;
-        CHECK(detail::raster_rect_portable(t, f, func, write, c.data(), W, r.x0, r.y0, r.x1, r.y1, false) ==
-              detail::raster_rect_avx2(t, f, func, write, d.data(), W, r.x0, r.y0, r.x1, r.y1, false));
+        e = c;
+        const std::uint64_t nc = detail::raster_rect_portable(t, f, func, write, c.data(), W, r.x0, r.y0, r.x1, r.y1, false);
+        CHECK(nc == detail::raster_rect_avx2(t, f, func, write, d.data(), W, r.x0, r.y0, r.x1, r.y1, false));
+        CHECK(nc == detail::raster_rect_avx512(t, f, func, write, e.data(), W, r.x0, r.y0, r.x1, r.y1, false));
         CHECK(c == d);
+        CHECK(c == e);
     }
     CHECK(std::all_of(a.begin(), a.end(), [](std::uint32_t x) { return x == kSentinel; }));
     CHECK(std::all_of(b.begin(), b.end(), [](std::uint32_t x) { return x == kSentinel; }));

@@ -111,10 +111,13 @@ struct ExecuteOptions {
 inline constexpr int kExecuteTileSize = 64;
 inline constexpr int kExecuteBlockSize = 8;
 
-// True when allow_simd runs the GL-exact AVX2 kernel in this process: it was built (x86-64, GCC or
-// Clang), the CPU has AVX2 and FMA, and CULLIDE_RASTER_NO_SIMD is unset or 0. For reports such as
-// `cullide --version`; results never depend on it (the kernels are bit-identical).
+// True when allow_simd runs a SIMD GL-exact kernel in this process: the AVX2 one was built (x86-64,
+// GCC or Clang), the CPU has AVX2 and FMA, and CULLIDE_RASTER_NO_SIMD is unset or 0. For reports
+// such as `cullide --version`; results never depend on it (the kernels are bit-identical).
 [[nodiscard]] bool simd_kernel_active();
+// Which GL-exact kernel allow_simd runs in this process: "AVX-512" (16 pixels per step, where the
+// CPU has AVX-512F and VL and CULLIDE_RASTER_NO_AVX512 is unset or 0), "AVX2" or "portable".
+[[nodiscard]] const char* simd_kernel_name();
 
 // Query results, indexed like begin_query() returned: samples passed for SamplesPassed queries,
 // 0 or 1 for AnySamplesPassed.
