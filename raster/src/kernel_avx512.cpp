@@ -52,28 +52,33 @@ inline __m512i encode16(__m512 z) {
     }
 }
 
+// GL's depth functions as AVX-512 compare predicates: unsigned integers (D16 / D24, whose stored
+// values order as unsigned 32-bit integers) and floats (D32F: ordered, and NotEqual unordered, as
+// C++'s operators). Never and Always compare nothing.
+template <DepthFunc F>
+constexpr int kIntPredicate = F == DepthFunc::Less       ? _MM_CMPINT_LT
+                              : F == DepthFunc::Equal    ? _MM_CMPINT_EQ
+                              : F == DepthFunc::LEqual   ? _MM_CMPINT_LE
+                              : F == DepthFunc::Greater  ? _MM_CMPINT_NLE
+                              : F == DepthFunc::NotEqual ? _MM_CMPINT_NE
+                                                         : _MM_CMPINT_NLT;  // GEqual
+template <DepthFunc F>
+constexpr int kFloatPredicate = F == DepthFunc::Less       ? _CMP_LT_OQ
+                                : F == DepthFunc::Equal    ? _CMP_EQ_OQ
+                                : F == DepthFunc::LEqual   ? _CMP_LE_OQ
+                                : F == DepthFunc::Greater  ? _CMP_GT_OQ
+                                : F == DepthFunc::NotEqual ? _CMP_NEQ_UQ
+                                                           : _CMP_GE_OQ;  // GEqual
+
 // The lanes of `cover` where depth_pass<F>(incoming, stored) holds.
 template <DepthFormat Fmt, DepthFunc F>
 inline __mmask16 pass16(__mmask16 cover, __m512i incoming, __m512i stored) {
     if constexpr (F == DepthFunc::Never) return 0;
-    if constexpr (F == DepthFunc::Always) return cover;
-    if constexpr (Fmt == DepthFormat::D32F) {
-        const __m512 a = _mm512_castsi512_ps(incoming), b = _mm512_castsi512_ps(stored);
-        if constexpr (F == DepthFunc::Less) return _mm512_mask_cmp_ps_mask(cover, a, b, _CMP_LT_OQ);
-        if constexpr (F == DepthFunc::Equal) return _mm512_mask_cmp_ps_mask(cover, a, b, _CMP_EQ_OQ);
-        if constexpr (F == DepthFunc::LEqual) return _mm512_mask_cmp_ps_mask(cover, a, b, _CMP_LE_OQ);
-        if constexpr (F == DepthFunc::Greater) return _mm512_mask_cmp_ps_mask(cover, a, b, _CMP_GT_OQ);
-        if constexpr (F == DepthFunc::NotEqual) return _mm512_mask_cmp_ps_mask(cover, a, b, _CMP_NEQ_UQ);
-        if constexpr (F == DepthFunc::GEqual) return _mm512_mask_cmp_ps_mask(cover, a, b, _CMP_GE_OQ);
-    } else {  // D16 / D24: unsigned 32-bit order
-        if constexpr (F == DepthFunc::Less) return _mm512_mask_cmplt_epu32_mask(cover, incoming, stored);
-        if constexpr (F == DepthFunc::Equal) return _mm512_mask_cmpeq_epu32_mask(cover, incoming, stored);
-        if constexpr (F == DepthFunc::LEqual) return _mm512_mask_cmple_epu32_mask(cover, incoming, stored);
-        if constexpr (F == DepthFunc::Greater) return _mm512_mask_cmpgt_epu32_mask(cover, incoming, stored);
-        if constexpr (F == DepthFunc::NotEqual) return _mm512_mask_cmpneq_epu32_mask(cover, incoming, stored);
-        if constexpr (F == DepthFunc::GEqual) return _mm512_mask_cmpge_epu32_mask(cover, incoming, stored);
-    }
-    return 0;
+    else if constexpr (F == DepthFunc::Always) return cover;
+    else if constexpr (Fmt == DepthFormat::D32F)
+        return _mm512_mask_cmp_ps_mask(cover, _mm512_castsi512_ps(incoming), _mm512_castsi512_ps(stored),
+                                       kFloatPredicate<F>);
+    else return _mm512_mask_cmp_epu32_mask(cover, incoming, stored, kIntPredicate<F>);
 }
 
 // encode16 and pass16 for 8 lanes (narrow_rows8).
@@ -92,24 +97,11 @@ inline __m256i encode8(__m256 z) {
 template <DepthFormat Fmt, DepthFunc F>
 inline __mmask8 pass8(__mmask8 cover, __m256i incoming, __m256i stored) {
     if constexpr (F == DepthFunc::Never) return 0;
-    if constexpr (F == DepthFunc::Always) return cover;
-    if constexpr (Fmt == DepthFormat::D32F) {
-        const __m256 a = _mm256_castsi256_ps(incoming), b = _mm256_castsi256_ps(stored);
-        if constexpr (F == DepthFunc::Less) return _mm256_mask_cmp_ps_mask(cover, a, b, _CMP_LT_OQ);
-        if constexpr (F == DepthFunc::Equal) return _mm256_mask_cmp_ps_mask(cover, a, b, _CMP_EQ_OQ);
-        if constexpr (F == DepthFunc::LEqual) return _mm256_mask_cmp_ps_mask(cover, a, b, _CMP_LE_OQ);
-        if constexpr (F == DepthFunc::Greater) return _mm256_mask_cmp_ps_mask(cover, a, b, _CMP_GT_OQ);
-        if constexpr (F == DepthFunc::NotEqual) return _mm256_mask_cmp_ps_mask(cover, a, b, _CMP_NEQ_UQ);
-        if constexpr (F == DepthFunc::GEqual) return _mm256_mask_cmp_ps_mask(cover, a, b, _CMP_GE_OQ);
-    } else {
-        if constexpr (F == DepthFunc::Less) return _mm256_mask_cmplt_epu32_mask(cover, incoming, stored);
-        if constexpr (F == DepthFunc::Equal) return _mm256_mask_cmpeq_epu32_mask(cover, incoming, stored);
-        if constexpr (F == DepthFunc::LEqual) return _mm256_mask_cmple_epu32_mask(cover, incoming, stored);
-        if constexpr (F == DepthFunc::Greater) return _mm256_mask_cmpgt_epu32_mask(cover, incoming, stored);
-        if constexpr (F == DepthFunc::NotEqual) return _mm256_mask_cmpneq_epu32_mask(cover, incoming, stored);
-        if constexpr (F == DepthFunc::GEqual) return _mm256_mask_cmpge_epu32_mask(cover, incoming, stored);
-    }
-    return 0;
+    else if constexpr (F == DepthFunc::Always) return cover;
+    else if constexpr (Fmt == DepthFormat::D32F)
+        return _mm256_mask_cmp_ps_mask(cover, _mm256_castsi256_ps(incoming), _mm256_castsi256_ps(stored),
+                                       kFloatPredicate<F>);
+    else return _mm256_mask_cmp_epu32_mask(cover, incoming, stored, kIntPredicate<F>);
 }
 
 struct Plane16 {

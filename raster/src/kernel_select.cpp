@@ -4,22 +4,24 @@
 #include <cstdlib>
 
 #include "pipeline.h"
+#include "raster/command_batch.h"
 
 namespace raster::detail {
+namespace {
+// A switch variable that is unset, empty or "0" (off).
+bool env_switch_off(const char* name) {
+    const char* v = std::getenv(name);
+    return v == nullptr || v[0] == '\0' || (v[0] == '0' && v[1] == '\0');
+}
+}  // namespace
 
 bool simd_allowed_by_environment() {
-    static const bool ok = [] {
-        const char* v = std::getenv("CULLIDE_RASTER_NO_SIMD");
-        return v == nullptr || v[0] == '\0' || (v[0] == '0' && v[1] == '\0');
-    }();
+    static const bool ok = env_switch_off("CULLIDE_RASTER_NO_SIMD");
     return ok;
 }
 
 bool avx512_allowed_by_environment() {
-    static const bool ok = [] {
-        const char* v = std::getenv("CULLIDE_RASTER_NO_AVX512");
-        return v == nullptr || v[0] == '\0' || (v[0] == '0' && v[1] == '\0');
-    }();
+    static const bool ok = env_switch_off("CULLIDE_RASTER_NO_AVX512");
     return ok;
 }
 
@@ -62,3 +64,16 @@ std::uint64_t raster_rect_hiz(const SetupTri& tri, const DepthState& state, Dept
 }
 
 }  // namespace raster::detail
+
+namespace raster {
+
+const char* simd_kernel_name() {
+    switch (detail::kernel_for(true)) {
+        case detail::Kernel::Avx512: return "AVX-512";
+        case detail::Kernel::Avx2: return "AVX2";
+        case detail::Kernel::Portable: break;
+    }
+    return "portable";
+}
+
+}  // namespace raster

@@ -518,9 +518,4 @@ namespace raster {
 
 bool simd_kernel_active() { return detail::kernel_avx2_available() && detail::simd_allowed_by_environment(); }
 
-const char* simd_kernel_name() {
-    if (!simd_kernel_active()) return "portable";
-    return detail::kernel_avx512_available() && detail::avx512_allowed_by_environment() ? "AVX-512" : "AVX2";
-}
-
 }  // namespace raster
