@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string>
 
+#include "cullide/predicates.h"
 #include "cullide_detail.h"
 #include "exact_stage.h"
 #include "parallel.h"
@@ -463,12 +464,6 @@ Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideO
     return Status{};
 }
 
-std::vector<raster::Double3> to_double3(const Mesh& m) {
-    std::vector<raster::Double3> p(m.positions.size());
-    for (std::size_t i = 0; i < p.size(); ++i) p[i] = {m.positions[i].x, m.positions[i].y, m.positions[i].z};
-    return p;
-}
-
 Result<ViewSize> check_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
                               const CullideOptions& o, bool scene_checked) {
     if (!(o.min_prune < 1.0))  // NaN too
@@ -504,11 +499,12 @@ std::vector<TrianglePair> exact_stage(std::span<const Mesh> objects, std::span<c
 // Stage 1's geometry: each active object's box as one item of 12 triangles.
 std::vector<ObjectGeometry> box_geometry(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
                                          int threads) {
+    const std::vector<Aabb> bounds = detail::object_bounds(objects, active, threads);
     std::vector<ObjectGeometry> boxes(active.size());
     detail::parallel_chunks(threads, active.size(), [&](std::size_t k) {  // each fills its own geometry
         ObjectGeometry& og = boxes[k];
         og.active_index = static_cast<std::uint32_t>(k);
-        const Aabb b = mesh_bounds(objects[active[k]]);
+        const Aabb& b = bounds[k];
         og.positions.resize(8);
         for (std::size_t c = 0; c < 8; ++c)
             og.positions[c] = {(c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z};
@@ -525,16 +521,42 @@ std::vector<ObjectGeometry> object_geometry(std::span<const Mesh> objects, std::
     for (const ObjectGeometry& b : boxes)
         if (b.items[0].live) live.push_back(&b);
     std::vector<ObjectGeometry> whole(live.size());
-    detail::parallel_chunks(threads, live.size(), [&](std::size_t k) {  // each fills its own geometry
+    detail::parallel_chunks(threads, live.size(), [&](std::size_t k) {  // each sizes its own geometry
         const ObjectGeometry& b = *live[k];
         const Mesh& m = objects[active[b.active_index]];
         ObjectGeometry& og = whole[k];
         og.active_index = b.active_index;
-        og.positions = to_double3(m);
+        og.positions.resize(m.positions.size());
         og.indices.resize(m.triangles.size() * 3);
-        for (std::size_t t = 0; t < m.triangles.size(); ++t)
-            std::copy(m.triangles[t].begin(), m.triangles[t].end(), og.indices.begin() + static_cast<std::ptrdiff_t>(3 * t));
         og.items.push_back({0, static_cast<std::uint32_t>(og.indices.size()), b.items[0].box, true, {}});
+    });
+    // The copies in parts of at most kCopyPart positions or triangles, each job writing its own
+    // range: one job per object left a thread alone with the tree of leaves (perf, 2 threads).
+    constexpr std::size_t kCopyPart = 16384;
+    struct Part {
+        std::size_t k;
+        bool positions;  // else triangles
+        std::size_t first, last;
+    };
+    std::vector<Part> parts;
+    for (std::size_t k = 0; k < live.size(); ++k) {
+        const Mesh& m = objects[active[live[k]->active_index]];
+        for (std::size_t f = 0; f < m.positions.size(); f += kCopyPart)
+            parts.push_back({k, true, f, std::min(m.positions.size(), f + kCopyPart)});
+        for (std::size_t f = 0; f < m.triangles.size(); f += kCopyPart)
+            parts.push_back({k, false, f, std::min(m.triangles.size(), f + kCopyPart)});
+    }
+    detail::parallel_chunks(threads, parts.size(), [&](std::size_t j) {
+        const Part& part = parts[j];
+        const Mesh& m = objects[active[live[part.k]->active_index]];
+        ObjectGeometry& og = whole[part.k];
+        if (part.positions) {
+            for (std::size_t i = part.first; i < part.last; ++i)
+                og.positions[i] = {m.positions[i].x, m.positions[i].y, m.positions[i].z};
+            return;
+        }
+        for (std::size_t t = part.first; t < part.last; ++t)
+            std::copy(m.triangles[t].begin(), m.triangles[t].end(), og.indices.begin() + static_cast<std::ptrdiff_t>(3 * t));
     });
     return whole;
 }
@@ -633,6 +655,86 @@ Result<std::vector<TrianglePair>> detail::cullide_pairs(std::span<const Mesh> ob
 }  // namespace cullide
 
 namespace cullide::detail {
+
+std::vector<Aabb> object_bounds(std::span<const Mesh> objects, std::span<const std::uint32_t> active, int threads) {
+    struct Job {
+        std::size_t k, first, last;  // triangles [first, last) of objects[active[k]]
+    };
+    std::vector<Job> jobs;
+    for (std::size_t k = 0; k < active.size(); ++k) {
+        const std::size_t n = objects[active[k]].triangles.size();
+        for (std::size_t f = 0; f < n; f += kBoundsTriangles) jobs.push_back({k, f, std::min(n, f + kBoundsTriangles)});
+    }
+    std::vector<Aabb> job_box(jobs.size());
+    parallel_chunks(threads, jobs.size(), [&](std::size_t j) {
+        const Mesh& m = objects[active[jobs[j].k]];
+        const Vec3* const pos = m.positions.data();
+        // mesh_bounds' loop over [first, last): the first vertex, then std::min / std::max with every
+        // vertex of every triangle in order, six doubles in registers.
+        const Vec3& p0 = pos[m.triangles[jobs[j].first][0]];
+        double x0 = p0.x, y0 = p0.y, z0 = p0.z, x1 = p0.x, y1 = p0.y, z1 = p0.z;
+        for (std::size_t t = jobs[j].first; t < jobs[j].last; ++t) {
+            for (const std::uint32_t v : m.triangles[t]) {
+                const Vec3& p = pos[v];
+                x0 = std::min(x0, p.x);
+                y0 = std::min(y0, p.y);
+                z0 = std::min(z0, p.z);
+                x1 = std::max(x1, p.x);
+                y1 = std::max(y1, p.y);
+                z1 = std::max(z1, p.z);
+            }
+        }
+        job_box[j] = {{x0, y0, z0}, {x1, y1, z1}};
+    });
+    std::vector<Aabb> boxes(active.size());
+    for (std::size_t j = 0; j < jobs.size(); ++j) {
+        Aabb& b = boxes[jobs[j].k];
+        const Aabb& c = job_box[j];
+        if (jobs[j].first == 0) {
+            b = c;
+            continue;
+        }
+        b.lo = {std::min(b.lo.x, c.lo.x), std::min(b.lo.y, c.lo.y), std::min(b.lo.z, c.lo.z)};
+        b.hi = {std::max(b.hi.x, c.hi.x), std::max(b.hi.y, c.hi.y), std::max(b.hi.z, c.hi.z)};
+    }
+    return boxes;
+}
+
+bool scene_clean(std::span<const Mesh> objects, int threads) {
+    struct Job {
+        std::size_t object;
+        bool positions;              // else triangles
+        std::size_t first, last;     // of the positions or triangles
+    };
+    std::vector<Job> jobs;
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+        const Mesh& m = objects[i];
+        if (m.triangles.empty()) return false;
+        for (std::size_t f = 0; f < m.positions.size(); f += kCheckPart)
+            jobs.push_back({i, true, f, std::min(m.positions.size(), f + kCheckPart)});
+        for (std::size_t f = 0; f < m.triangles.size(); f += kCheckPart)
+            jobs.push_back({i, false, f, std::min(m.triangles.size(), f + kCheckPart)});
+    }
+    std::vector<char> ok(jobs.size(), 0);
+    parallel_chunks(threads, jobs.size(), [&](std::size_t j) {
+        const Job& job = jobs[j];
+        const Mesh& m = objects[job.object];
+        bool good = true;
+        if (job.positions) {
+            // predicate_coordinate_ok is false for NaN and infinities: validate_mesh's check too.
+            for (std::size_t v = job.first; v < job.last; ++v) {
+                const Vec3& p = m.positions[v];
+                good &= predicate_coordinate_ok(p.x) & predicate_coordinate_ok(p.y) & predicate_coordinate_ok(p.z);
+            }
+        } else {
+            const std::size_t n = m.positions.size();
+            for (std::size_t t = job.first; t < job.last; ++t)
+                good &= (m.triangles[t][0] < n) & (m.triangles[t][1] < n) & (m.triangles[t][2] < n);
+        }
+        ok[j] = good ? 1 : 0;
+    });
+    return std::all_of(ok.begin(), ok.end(), [](char c) { return c != 0; });
+}
 
 Result<ViewSize> check_visibility_inputs(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
                                          const VisibilityOptions& o, VisibilityMode mode, bool scene_checked) {

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "cullide/cullide.h"
 #include "cullide/quick_cullide.h"
@@ -59,6 +60,23 @@ inline constexpr std::size_t kTransformPart = 4096;
                                                        std::span<const std::uint32_t> active,
                                                        const VisibilityOptions& o, VisibilityMode mode,
                                                        bool scene_checked = false);
+
+// Every active object's mesh_bounds (the union of its triangles' boxes; empty without triangles), in
+// jobs of at most kBoundsTriangles triangles on `threads` workers, folded in job order. std::min and
+// std::max keep the earlier of equal values, so the boxes are mesh_bounds' bits (signed zeros
+// included) for any thread count. One job per object left a thread alone with the one object that
+// holds most of the triangles (the tree of leaves, the dragon, the cloth), and Quick-CULLIDE's box
+// stage ran mesh_bounds serially.
+inline constexpr std::size_t kBoundsTriangles = 8192;
+[[nodiscard]] std::vector<Aabb> object_bounds(std::span<const Mesh> objects, std::span<const std::uint32_t> active,
+                                              int threads);
+
+// True when validate_mesh and validate_exact_range_of find nothing in any object: each has
+// triangles, every coordinate is inside the exact range (finite included) and every index is in
+// range. In jobs of at most kCheckPart positions or triangles, so that one big object does not hold
+// one thread alone; a caller runs the per-object checks only when this is false, for their messages.
+inline constexpr std::size_t kCheckPart = 16384;
+[[nodiscard]] bool scene_clean(std::span<const Mesh> objects, int threads);
 
 // cullide_pairs and quick_cullide_pairs for a caller that has checked the scene (scene_checked as
 // above); the public functions are these with scene_checked = false.

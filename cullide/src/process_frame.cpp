@@ -78,11 +78,14 @@ Result<std::vector<std::uint32_t>> broad_phase(std::span<const Mesh> objects, co
         for (std::size_t i = 0; i < objects.size(); ++i) active.push_back(static_cast<std::uint32_t>(i));
         return active;
     }
+    std::vector<std::uint32_t> all(objects.size());
+    for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::uint32_t>(i);
+    const std::vector<Aabb> bounds = detail::object_bounds(objects, all, o.threads);
     std::vector<spatialhash::Box> boxes(objects.size());
-    detail::parallel_chunks(o.threads, objects.size(), [&](std::size_t i) {  // each writes its own box
-        const Aabb b = mesh_bounds(objects[i]);
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+        const Aabb& b = bounds[i];
         boxes[i] = {{b.lo.x, b.lo.y, b.lo.z}, {b.hi.x, b.hi.y, b.hi.z}};
-    });
+    }
     spatialhash::Options so;
     so.method = o.broadphase == BroadPhase::SpatialHash     ? spatialhash::Method::SpatialHash
                 : o.broadphase == BroadPhase::SweepAndPrune ? spatialhash::Method::SweepAndPrune
@@ -371,15 +374,21 @@ Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOption
         // job: the same first problem named as the two serial scans (they were 6% of the calling
         // thread's time in a 2-thread rcullide cylinders frame, perf).
         const std::size_t n = objects.size();
-        std::vector<Status> mesh_ok(n), range_ok(n);
-        detail::parallel_chunks(run.threads, n, [&](std::size_t i) {
-            mesh_ok[i] = validate_mesh(objects[i]);
-            range_ok[i] = detail::validate_exact_range_of(objects[i], i);
-        });
-        for (std::size_t i = 0; i < n; ++i)
-            if (!mesh_ok[i]) return Error{"object " + std::to_string(i) + ": " + mesh_ok[i].error().message};
-        for (std::size_t i = 0; i < n; ++i)
-            if (!range_ok[i]) return range_ok[i];
+        // The common case first: one scan in parts of at most detail::kCheckPart positions or
+        // triangles (one job per object left a thread alone with the tree of leaves or the cloth:
+        // the checks did not get faster with a second thread); the per-object scans below run only
+        // when it finds a problem, to name the first one.
+        if (!detail::scene_clean(objects, run.threads)) {
+            std::vector<Status> mesh_ok(n), range_ok(n);
+            detail::parallel_chunks(run.threads, n, [&](std::size_t i) {
+                mesh_ok[i] = validate_mesh(objects[i]);
+                range_ok[i] = detail::validate_exact_range_of(objects[i], i);
+            });
+            for (std::size_t i = 0; i < n; ++i)
+                if (!mesh_ok[i]) return Error{"object " + std::to_string(i) + ": " + mesh_ok[i].error().message};
+            for (std::size_t i = 0; i < n; ++i)
+                if (!range_ok[i]) return range_ok[i];
+        }
         if (objects.size() > UINT32_MAX) return Error{"too many objects (limit 2^32 - 1)"};
         return {};
     };

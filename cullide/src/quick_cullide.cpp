@@ -521,8 +521,9 @@ Status separate_stages(std::span<const Mesh> objects, std::span<const std::uint3
     auto t0 = Clock::now();
     std::vector<Geom> boxes(active.size());
     std::vector<Item> box_items(active.size());
+    const std::vector<Aabb> bounds = detail::object_bounds(objects, active, options.threads);
     for (std::size_t k = 0; k < active.size(); ++k) {
-        const Aabb b = mesh_bounds(objects[active[k]]);
+        const Aabb& b = bounds[k];
         Geom& g = boxes[k];
         g.object = active[k];
         g.positions.resize(8);

@@ -1,10 +1,14 @@
 // visibility_api_test.cpp: the pieces shared by every method (issue #15): the one exact stage
-// (cullide/src/exact_stage.h), QueryDevice::visibility_pass and its recorded default, and the view
-// resolution checked once against one range with the mode's default.
+// (cullide/src/exact_stage.h), QueryDevice::visibility_pass and its recorded default, the view
+// resolution checked once against one range with the mode's default, and the frame's parallel
+// object boxes and input scan (cullide/src/cullide_detail.h).
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -14,6 +18,7 @@
 #include "cullide/pipeline.h"
 #include "cullide/query_device.h"
 #include "cullide/scenes.h"
+#include "cullide_detail.h"
 #include "exact_stage.h"
 #include "test_rng.h"
 
@@ -179,4 +184,114 @@ TEST_CASE("the view resolution has one range, checked at the entry point, and th
     CHECK(a.value() == b.value());
     CHECK(implicit.queries == explicit_stats.queries);
     CHECK(implicit.triangles_rasterized == explicit_stats.triangles_rasterized);
+}
+
+namespace {
+
+// Bitwise equality of two boxes (signed zeros and NaN payloads count).
+bool same_bits(const cullide::Aabb& a, const cullide::Aabb& b) {
+    const double x[6] = {a.lo.x, a.lo.y, a.lo.z, a.hi.x, a.hi.y, a.hi.z};
+    const double y[6] = {b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z};
+    return std::memcmp(x, y, sizeof x) == 0;
+}
+
+}  // namespace
+
+TEST_CASE("object_bounds gives mesh_bounds' bits, in jobs of triangles on any thread count") {
+    // Objects of 1, kBoundsTriangles and 2.5 kBoundsTriangles + 7 triangles, on shared vertices, with
+    // +0 and -0 both at the minimum of each axis in different jobs: which zero wins depends on the
+    // order of the fold, so a fold out of mesh_bounds' order shows here.
+    test::Rng rng(31);
+    std::vector<cullide::Mesh> objects;
+    for (const std::size_t n : {std::size_t{1}, cullide::detail::kBoundsTriangles,
+                                cullide::detail::kBoundsTriangles * 5 / 2 + 7}) {
+        cullide::Mesh m;
+        m.name = "zeros";
+        for (std::size_t v = 0; v < 64; ++v) m.positions.push_back({rng.uniform(0, 1), rng.uniform(0, 1), rng.uniform(0, 1)});
+        m.positions.push_back({-0.0, -0.0, -0.0});  // 64
+        m.positions.push_back({0.0, 0.0, 0.0});     // 65
+        for (std::size_t t = 0; t < n; ++t) {
+            auto pick = [&] { return static_cast<std::uint32_t>(rng.below(64)); };
+            cullide::Tri tri{pick(), pick(), pick()};
+            if (t == n - 1) tri[2] = 64;  // -0 in the last job
+            if (t == n / 2) tri[0] = 65;  // +0 earlier (for n = 1: an earlier vertex of the same triangle)
+            m.triangles.push_back(tri);
+        }
+        objects.push_back(std::move(m));
+    }
+    const std::vector<std::uint32_t> active = {0, 1, 2};
+    for (const int threads : {1, 2}) {
+        const std::vector<cullide::Aabb> boxes = cullide::detail::object_bounds(objects, active, threads);
+        REQUIRE(boxes.size() == objects.size());
+        for (std::size_t k = 0; k < objects.size(); ++k) {
+            CAPTURE(k);
+            CAPTURE(threads);
+            CHECK(same_bits(boxes[k], cullide::mesh_bounds(objects[k])));
+            CHECK(!std::signbit(boxes[k].lo.x));  // +0 came first in triangle order
+        }
+    }
+    // Only the listed objects, in `active`'s order; an object without triangles has the empty box.
+    objects.push_back(cullide::Mesh{});
+    const std::vector<std::uint32_t> some = {2, 3};
+    const std::vector<cullide::Aabb> two = cullide::detail::object_bounds(objects, some, 2);
+    REQUIRE(two.size() == 2);
+    CHECK(same_bits(two[0], cullide::mesh_bounds(objects[2])));
+    CHECK(two[1].empty());
+}
+
+TEST_CASE("scene_clean is true exactly when the per-object checks find nothing, wherever the problem is") {
+    // A clean scene of three objects, the big one spanning several check parts; then one problem at
+    // a time in each object, in the first and in the last part.
+    test::Rng rng(37);
+    std::vector<cullide::Mesh> clean;
+    for (const std::size_t n : {std::size_t{3}, cullide::detail::kCheckPart * 2 + 5, std::size_t{10}}) {
+        cullide::Mesh m;
+        m.name = "check";
+        for (std::size_t v = 0; v < n + 2; ++v) m.positions.push_back({rng.uniform(1, 2), rng.uniform(1, 2), rng.uniform(1, 2)});
+        for (std::size_t t = 0; t < n; ++t)
+            m.triangles.push_back({static_cast<std::uint32_t>(t), static_cast<std::uint32_t>(t + 1), static_cast<std::uint32_t>(t + 2)});
+        clean.push_back(std::move(m));
+    }
+    const auto per_object_ok = [](const std::vector<cullide::Mesh>& objects) {
+        for (std::size_t i = 0; i < objects.size(); ++i)
+            if (!cullide::validate_mesh(objects[i]) || !cullide::detail::validate_exact_range_of(objects[i], i)) return false;
+        return true;
+    };
+    for (const int threads : {1, 2}) {
+        CAPTURE(threads);
+        CHECK(cullide::detail::scene_clean(clean, threads));
+        CHECK(per_object_ok(clean));
+        const double bad_values[] = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+                                     -std::numeric_limits<double>::infinity(), 1e-310 /* subnormal */, 0x1p-301, 0x1p301};
+        for (std::size_t o = 0; o < clean.size(); ++o) {
+            for (const bool last : {false, true}) {
+                const std::size_t v = last ? clean[o].positions.size() - 1 : 0;
+                for (const double bad : bad_values) {
+                    for (int axis = 0; axis < 3; ++axis) {
+                        std::vector<cullide::Mesh> s = clean;
+                        (axis == 0 ? s[o].positions[v].x : axis == 1 ? s[o].positions[v].y : s[o].positions[v].z) = bad;
+                        CAPTURE(o);
+                        CAPTURE(v);
+                        CAPTURE(bad);
+                        CHECK(!per_object_ok(s));
+                        CHECK(!cullide::detail::scene_clean(s, threads));
+                    }
+                }
+                std::vector<cullide::Mesh> s = clean;
+                const std::size_t t = last ? s[o].triangles.size() - 1 : 0;
+                s[o].triangles[t][2] = static_cast<std::uint32_t>(s[o].positions.size());  // one beyond
+                CHECK(!per_object_ok(s));
+                CHECK(!cullide::detail::scene_clean(s, threads));
+            }
+            std::vector<cullide::Mesh> s = clean;
+            s[o].triangles.clear();
+            CHECK(!per_object_ok(s));
+            CHECK(!cullide::detail::scene_clean(s, threads));
+        }
+        // Exact zero is inside the range.
+        std::vector<cullide::Mesh> z = clean;
+        z[1].positions.back() = {0.0, -0.0, 0.0};
+        CHECK(per_object_ok(z));
+        CHECK(cullide::detail::scene_clean(z, threads));
+    }
 }
