@@ -265,22 +265,24 @@ class CellFlags {
         for (int y = r.y0 >> 3; y <= r.y1 >> 3; ++y) {
             const auto c = static_cast<std::size_t>(y);
             const int fy0 = std::max(r.y0, y * 8), fy1 = std::min(r.y1, y * 8 + 7);
-            for (std::uint64_t cells = (some_[c] | all_[c]) & cmask; cells != 0; cells &= cells - 1) {
-                const int x = std::countr_zero(cells);
-                const int fx0 = std::max(r.x0, x * 8), fx1 = std::min(r.x1, x * 8 + 7);
-                if ((all_[c] >> x) & 1u) {
-                    extend(fx0, fy0, fx1, fy1);
-                    continue;
-                }
-                const std::uint64_t m0 = span_bits(fx0, fx1, 0), m1 = span_bits(fx0, fx1, 1);
-                for (int fy = fy0; fy <= fy1; ++fy) {
-                    const std::uint64_t* row = fine_.data() + 2 * static_cast<std::size_t>(fy);
-                    const std::uint64_t w0 = row[0] & m0, w1 = row[1] & m1;
-                    if ((w0 | w1) == 0) continue;
-                    const int lo = w0 != 0 ? std::countr_zero(w0) : 64 + std::countr_zero(w1);
-                    const int hi = w1 != 0 ? 127 - std::countl_zero(w1) : 63 - std::countl_zero(w0);
-                    extend(lo, fy, hi, fy);
-                }
+            // The `all` cells of this coarse row share its rows: their union is one box, from the
+            // first to the last of them, cut to r.
+            const std::uint64_t all = all_[c] & cmask;
+            if (all != 0) {
+                extend(std::max(r.x0, std::countr_zero(all) * 8), fy0,
+                       std::min(r.x1, (63 - std::countl_zero(all)) * 8 + 7), fy1);
+            }
+            // Fine flags lie only in cells flagged `some`; those inside an `all` cell are in its box
+            // already, so with any `some` cell not `all`, each row's flags within r extend the box.
+            if ((some_[c] & ~all_[c] & cmask) == 0) continue;
+            const std::uint64_t m0 = span_bits(r.x0, r.x1, 0), m1 = span_bits(r.x0, r.x1, 1);
+            for (int fy = fy0; fy <= fy1; ++fy) {
+                const std::uint64_t* row = fine_.data() + 2 * static_cast<std::size_t>(fy);
+                const std::uint64_t w0 = row[0] & m0, w1 = row[1] & m1;
+                if ((w0 | w1) == 0) continue;
+                const int lo = w0 != 0 ? std::countr_zero(w0) : 64 + std::countr_zero(w1);
+                const int hi = w1 != 0 ? 127 - std::countl_zero(w1) : 63 - std::countl_zero(w0);
+                extend(lo, fy, hi, fy);
             }
         }
         return b;
