@@ -461,6 +461,77 @@ TEST_CASE("overlapping_sets gives the sorted multiset of overlapping set pairs o
     CHECK(total_pairs > 10000);
 }
 
+TEST_CASE("overlapping_sets' grid gives the brute-force pairs on boxes spread in every axis") {
+    // Above the grid's threshold (1,024 refs): thin boxes on a torus-like ring (the case the grid is
+    // for), boxes on a lattice that touch face to face (a touching pair is an overlap: the low
+    // corner of their common part lies on a cell border), flat boxes, repeated boxes, and a few
+    // boxes over everything (many cells each: at enough of them the plain sweep takes over).
+    test::Rng rng(4242);
+    const auto brute = [](const std::vector<cullide::detail::SweepRef>& refs) {
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> want;
+        for (std::size_t i = 0; i < refs.size(); ++i)
+            for (std::size_t j = i + 1; j < refs.size(); ++j)
+                if (cullide::overlaps(refs[i].box, refs[j].box))
+                    want.emplace_back(std::min(refs[i].set, refs[j].set), std::max(refs[i].set, refs[j].set));
+        std::sort(want.begin(), want.end());
+        return want;
+    };
+    std::size_t total_pairs = 0;
+    for (int shape = 0; shape < 5; ++shape) {
+        std::vector<cullide::detail::SweepRef> refs;
+        const auto add = [&](cullide::Vec3 lo, cullide::Vec3 hi) {
+            cullide::detail::SweepRef r;
+            r.box = {lo, hi};
+            r.set = static_cast<std::uint32_t>(refs.size() % 1500);  // repeated sets: repeated pairs
+            r.part = static_cast<std::uint32_t>(refs.size());
+            refs.push_back(r);
+        };
+        if (shape == 0 || shape == 4) {  // a ring of thin boxes in the x-y plane
+            for (int i = 0; i < 3000; ++i) {
+                const double a = rng.uniform(0, 6.283185307179586), r = 10.0 + rng.uniform(-1, 1);
+                const cullide::Vec3 c{r * std::cos(a), r * std::sin(a), rng.uniform(-1, 1)};
+                const cullide::Vec3 e{rng.uniform(0, 0.3), rng.uniform(0, 0.3), rng.uniform(0, 0.3)};
+                add(c, c + e);
+            }
+        } else if (shape == 1) {  // a lattice of unit boxes touching their neighbours
+            for (int x = 0; x < 12; ++x)
+                for (int y = 0; y < 12; ++y)
+                    for (int z = 0; z < 12; ++z) add({double(x), double(y), double(z)}, {x + 1.0, y + 1.0, z + 1.0});
+        } else if (shape == 2) {  // flat boxes (no extent along one or two axes) and repeated boxes
+            for (int i = 0; i < 2000; ++i) {
+                const cullide::Vec3 c{rng.grid(0, 8, 4), rng.grid(0, 8, 4), rng.grid(0, 8, 4)};
+                const cullide::Vec3 e{rng.coin() ? 0.0 : 0.25, rng.coin() ? 0.0 : 0.25, 0.0};
+                add(c, c + e);
+                if (i % 7 == 0) add(c, c + e);
+            }
+        } else {  // shape 3: small boxes and a few that cover everything
+            for (int i = 0; i < 2500; ++i) {
+                const cullide::Vec3 c{rng.uniform(0, 20), rng.uniform(0, 20), rng.uniform(0, 20)};
+                add(c, c + cullide::Vec3{0.2, 0.2, 0.2});
+            }
+            for (int i = 0; i < 3; ++i) add({-1, -1, -1}, {21, 21, 21});
+        }
+        if (shape == 4)  // enough boxes over everything for the plain sweep to take over
+            for (int i = 0; i < 40; ++i) add({-12, -12, -2}, {12, 12, 2});
+        const auto want = brute(refs);
+        for (const int threads : {1, 2, 3}) {
+            CAPTURE(shape);
+            CAPTURE(threads);
+            CHECK(cullide::detail::overlapping_sets(refs, threads) == want);
+            std::uint64_t overlapping = 0;
+            const auto odd = cullide::detail::overlapping_sets(
+                refs, threads, [](std::uint32_t a, std::uint32_t b) { return (a + b) % 2 == 1; }, overlapping);
+            std::vector<std::pair<std::uint32_t, std::uint32_t>> want_odd;
+            for (const auto& p : want)
+                if ((p.first + p.second) % 2 == 1) want_odd.push_back(p);
+            CHECK(odd == want_odd);
+            CHECK(overlapping == want.size());
+        }
+        total_pairs += want.size();
+    }
+    CHECK(total_pairs > 20000);
+}
+
 TEST_CASE("the result is the same for 1, 2, 3 and 8 threads") {
     std::vector<Mesh> scene = random_scene(77, 40, 120, true);
     cullide::ExactStats s1;
