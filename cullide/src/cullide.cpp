@@ -686,17 +686,10 @@ std::vector<Aabb> object_bounds(std::span<const Mesh> objects, std::span<const s
         }
         job_box[j] = {{x0, y0, z0}, {x1, y1, z1}};
     });
+    // In job order: unite takes the first job's box as it is (the empty box is its identity), then
+    // std::min / std::max with the box so far first.
     std::vector<Aabb> boxes(active.size());
-    for (std::size_t j = 0; j < jobs.size(); ++j) {
-        Aabb& b = boxes[jobs[j].k];
-        const Aabb& c = job_box[j];
-        if (jobs[j].first == 0) {
-            b = c;
-            continue;
-        }
-        b.lo = {std::min(b.lo.x, c.lo.x), std::min(b.lo.y, c.lo.y), std::min(b.lo.z, c.lo.z)};
-        b.hi = {std::max(b.hi.x, c.hi.x), std::max(b.hi.y, c.hi.y), std::max(b.hi.z, c.hi.z)};
-    }
+    for (std::size_t j = 0; j < jobs.size(); ++j) boxes[jobs[j].k] = unite(boxes[jobs[j].k], job_box[j]);
     return boxes;
 }
 

@@ -423,6 +423,39 @@ TEST_CASE("one big pair task, made in chunks on several workers, gives the seria
     }
 }
 
+namespace {
+
+// The overlapping pairs of a brute-force double loop, sorted (what overlapping_sets must return).
+std::vector<std::pair<std::uint32_t, std::uint32_t>> brute_overlaps(const std::vector<cullide::detail::SweepRef>& refs) {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> want;
+    for (std::size_t i = 0; i < refs.size(); ++i)
+        for (std::size_t j = i + 1; j < refs.size(); ++j)
+            if (cullide::overlaps(refs[i].box, refs[j].box))
+                want.emplace_back(std::min(refs[i].set, refs[j].set), std::max(refs[i].set, refs[j].set));
+    std::sort(want.begin(), want.end());
+    return want;
+}
+
+// overlapping_sets on `refs` against `want` for 1 to 3 threads, without a filter and with one (the
+// kept pairs in the same order, and the count of all overlaps).
+void check_overlapping_sets(const std::vector<cullide::detail::SweepRef>& refs,
+                            const std::vector<std::pair<std::uint32_t, std::uint32_t>>& want) {
+    for (const int threads : {1, 2, 3}) {
+        CAPTURE(threads);
+        CHECK(cullide::detail::overlapping_sets(refs, threads) == want);
+        std::uint64_t overlapping = 0;
+        const auto odd = cullide::detail::overlapping_sets(
+            refs, threads, [](std::uint32_t a, std::uint32_t b) { return (a + b) % 2 == 1; }, overlapping);
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> want_odd;
+        for (const auto& p : want)
+            if ((p.first + p.second) % 2 == 1) want_odd.push_back(p);
+        CHECK(odd == want_odd);
+        CHECK(overlapping == want.size());
+    }
+}
+
+}  // namespace
+
 TEST_CASE("overlapping_sets gives the sorted multiset of overlapping set pairs of a brute-force double loop") {
     test::Rng rng(777);
     std::size_t total_pairs = 0;
@@ -436,26 +469,9 @@ TEST_CASE("overlapping_sets gives the sorted multiset of overlapping set pairs o
             refs[i].set = static_cast<std::uint32_t>(rng.below(n / 2 + 1));  // sets of several parts: repeated pairs
             refs[i].part = static_cast<std::uint32_t>(i);
         }
-        std::vector<std::pair<std::uint32_t, std::uint32_t>> want;
-        for (std::size_t i = 0; i < n; ++i)
-            for (std::size_t j = i + 1; j < n; ++j)
-                if (cullide::overlaps(refs[i].box, refs[j].box))
-                    want.emplace_back(std::min(refs[i].set, refs[j].set), std::max(refs[i].set, refs[j].set));
-        std::sort(want.begin(), want.end());
-        for (const int threads : {1, 2, 3}) {
-            CAPTURE(n);
-            CAPTURE(threads);
-            CHECK(cullide::detail::overlapping_sets(refs, threads) == want);
-            // With a filter: the kept pairs in the same order, and the count of all overlaps.
-            std::uint64_t overlapping = 0;
-            const auto odd = cullide::detail::overlapping_sets(
-                refs, threads, [](std::uint32_t a, std::uint32_t b) { return (a + b) % 2 == 1; }, overlapping);
-            std::vector<std::pair<std::uint32_t, std::uint32_t>> want_odd;
-            for (const auto& p : want)
-                if ((p.first + p.second) % 2 == 1) want_odd.push_back(p);
-            CHECK(odd == want_odd);
-            CHECK(overlapping == want.size());
-        }
+        const auto want = brute_overlaps(refs);
+        CAPTURE(n);
+        check_overlapping_sets(refs, want);
         total_pairs += want.size();
     }
     CHECK(total_pairs > 10000);
@@ -467,15 +483,6 @@ TEST_CASE("overlapping_sets' grid gives the brute-force pairs on boxes spread in
     // corner of their common part lies on a cell border), flat boxes, repeated boxes, and a few
     // boxes over everything (many cells each: at enough of them the plain sweep takes over).
     test::Rng rng(4242);
-    const auto brute = [](const std::vector<cullide::detail::SweepRef>& refs) {
-        std::vector<std::pair<std::uint32_t, std::uint32_t>> want;
-        for (std::size_t i = 0; i < refs.size(); ++i)
-            for (std::size_t j = i + 1; j < refs.size(); ++j)
-                if (cullide::overlaps(refs[i].box, refs[j].box))
-                    want.emplace_back(std::min(refs[i].set, refs[j].set), std::max(refs[i].set, refs[j].set));
-        std::sort(want.begin(), want.end());
-        return want;
-    };
     std::size_t total_pairs = 0;
     for (int shape = 0; shape < 5; ++shape) {
         std::vector<cullide::detail::SweepRef> refs;
@@ -513,20 +520,9 @@ TEST_CASE("overlapping_sets' grid gives the brute-force pairs on boxes spread in
         }
         if (shape == 4)  // enough boxes over everything for the plain sweep to take over
             for (int i = 0; i < 40; ++i) add({-12, -12, -2}, {12, 12, 2});
-        const auto want = brute(refs);
-        for (const int threads : {1, 2, 3}) {
-            CAPTURE(shape);
-            CAPTURE(threads);
-            CHECK(cullide::detail::overlapping_sets(refs, threads) == want);
-            std::uint64_t overlapping = 0;
-            const auto odd = cullide::detail::overlapping_sets(
-                refs, threads, [](std::uint32_t a, std::uint32_t b) { return (a + b) % 2 == 1; }, overlapping);
-            std::vector<std::pair<std::uint32_t, std::uint32_t>> want_odd;
-            for (const auto& p : want)
-                if ((p.first + p.second) % 2 == 1) want_odd.push_back(p);
-            CHECK(odd == want_odd);
-            CHECK(overlapping == want.size());
-        }
+        const auto want = brute_overlaps(refs);
+        CAPTURE(shape);
+        check_overlapping_sets(refs, want);
         total_pairs += want.size();
     }
     CHECK(total_pairs > 20000);
