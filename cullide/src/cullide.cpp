@@ -712,19 +712,21 @@ bool scene_clean(std::span<const Mesh> objects, int threads) {
     parallel_chunks(threads, jobs.size(), [&](std::size_t j) {
         const Job& job = jobs[j];
         const Mesh& m = objects[job.object];
-        bool good = true;
+        // Flags ANDed without branches (the scan runs to the end of its part either way).
+        const auto u = [](bool b) { return static_cast<std::uint32_t>(b); };
+        std::uint32_t good = 1;
         if (job.positions) {
             // predicate_coordinate_ok is false for NaN and infinities: validate_mesh's check too.
             for (std::size_t v = job.first; v < job.last; ++v) {
                 const Vec3& p = m.positions[v];
-                good &= predicate_coordinate_ok(p.x) & predicate_coordinate_ok(p.y) & predicate_coordinate_ok(p.z);
+                good &= u(predicate_coordinate_ok(p.x)) & u(predicate_coordinate_ok(p.y)) & u(predicate_coordinate_ok(p.z));
             }
         } else {
             const std::size_t n = m.positions.size();
             for (std::size_t t = job.first; t < job.last; ++t)
-                good &= (m.triangles[t][0] < n) & (m.triangles[t][1] < n) & (m.triangles[t][2] < n);
+                good &= u(m.triangles[t][0] < n) & u(m.triangles[t][1] < n) & u(m.triangles[t][2] < n);
         }
-        ok[j] = good ? 1 : 0;
+        ok[j] = good != 0 ? 1 : 0;
     });
     return std::all_of(ok.begin(), ok.end(), [](char c) { return c != 0; });
 }
