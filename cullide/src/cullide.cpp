@@ -60,6 +60,27 @@ struct ObjectGeometry {
     raster::OffsetMesh offset;
 };
 
+// One parallel job's share of a mesh: its positions or its triangles [first, last), at most `part`
+// of them, of mesh k. mesh_parts cuts meshes 0 .. n-1 (mesh_of(k)), positions then triangles each, so
+// that one big mesh does not hold one thread alone (the tree of leaves, the cloth).
+struct MeshPart {
+    std::size_t k;
+    bool positions;  // else triangles
+    std::size_t first, last;
+};
+template <class MeshOf>
+std::vector<MeshPart> mesh_parts(std::size_t n, MeshOf&& mesh_of, std::size_t part) {
+    std::vector<MeshPart> parts;
+    for (std::size_t k = 0; k < n; ++k) {
+        const Mesh& m = mesh_of(k);
+        for (std::size_t f = 0; f < m.positions.size(); f += part)
+            parts.push_back({k, true, f, std::min(m.positions.size(), f + part)});
+        for (std::size_t f = 0; f < m.triangles.size(); f += part)
+            parts.push_back({k, false, f, std::min(m.triangles.size(), f + part)});
+    }
+    return parts;
+}
+
 }  // namespace
 
 // Shared with quick_cullide.cpp (cullide_detail.h).
@@ -533,21 +554,10 @@ std::vector<ObjectGeometry> object_geometry(std::span<const Mesh> objects, std::
     // The copies in parts of at most kCopyPart positions or triangles, each job writing its own
     // range: one job per object left a thread alone with the tree of leaves (perf, 2 threads).
     constexpr std::size_t kCopyPart = 16384;
-    struct Part {
-        std::size_t k;
-        bool positions;  // else triangles
-        std::size_t first, last;
-    };
-    std::vector<Part> parts;
-    for (std::size_t k = 0; k < live.size(); ++k) {
-        const Mesh& m = objects[active[live[k]->active_index]];
-        for (std::size_t f = 0; f < m.positions.size(); f += kCopyPart)
-            parts.push_back({k, true, f, std::min(m.positions.size(), f + kCopyPart)});
-        for (std::size_t f = 0; f < m.triangles.size(); f += kCopyPart)
-            parts.push_back({k, false, f, std::min(m.triangles.size(), f + kCopyPart)});
-    }
+    const std::vector<MeshPart> parts = mesh_parts(
+        live.size(), [&](std::size_t k) -> const Mesh& { return objects[active[live[k]->active_index]]; }, kCopyPart);
     detail::parallel_chunks(threads, parts.size(), [&](std::size_t j) {
-        const Part& part = parts[j];
+        const MeshPart& part = parts[j];
         const Mesh& m = objects[active[live[part.k]->active_index]];
         ObjectGeometry& og = whole[part.k];
         if (part.positions) {
@@ -694,24 +704,14 @@ std::vector<Aabb> object_bounds(std::span<const Mesh> objects, std::span<const s
 }
 
 bool scene_clean(std::span<const Mesh> objects, int threads) {
-    struct Job {
-        std::size_t object;
-        bool positions;              // else triangles
-        std::size_t first, last;     // of the positions or triangles
-    };
-    std::vector<Job> jobs;
-    for (std::size_t i = 0; i < objects.size(); ++i) {
-        const Mesh& m = objects[i];
+    for (const Mesh& m : objects)
         if (m.triangles.empty()) return false;
-        for (std::size_t f = 0; f < m.positions.size(); f += kCheckPart)
-            jobs.push_back({i, true, f, std::min(m.positions.size(), f + kCheckPart)});
-        for (std::size_t f = 0; f < m.triangles.size(); f += kCheckPart)
-            jobs.push_back({i, false, f, std::min(m.triangles.size(), f + kCheckPart)});
-    }
+    const std::vector<MeshPart> jobs =
+        mesh_parts(objects.size(), [&](std::size_t k) -> const Mesh& { return objects[k]; }, kCheckPart);
     std::vector<char> ok(jobs.size(), 0);
     parallel_chunks(threads, jobs.size(), [&](std::size_t j) {
-        const Job& job = jobs[j];
-        const Mesh& m = objects[job.object];
+        const MeshPart& job = jobs[j];
+        const Mesh& m = objects[job.k];
         // Flags ANDed without branches (the scan runs to the end of its part either way).
         const auto u = [](bool b) { return static_cast<std::uint32_t>(b); };
         std::uint32_t good = 1;

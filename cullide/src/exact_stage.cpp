@@ -1015,11 +1015,20 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> overlapping_sets(
     sort_along(refs, axis);
     const SweepGrid g = refs.size() >= kGridMinRefs ? sweep_grid(refs, axis) : SweepGrid{};
     bool grid = g.nu * g.nv > 1;
+    // Each ref's cells, [u0, u1] x [v0, v1], found once for the count and the fill below.
+    struct CellRange {
+        int u0, u1, v0, v1;
+    };
+    std::vector<CellRange> range;
     if (grid) {  // a few large boxes could fill every cell: the plain sweep beyond kGridMaxEntries a ref
+        range.reserve(refs.size());
         std::uint64_t total = 0;
-        for (const SweepRef& r : refs)
-            total += static_cast<std::uint64_t>(g.cell_u(r.box.hi[g.u]) - g.cell_u(r.box.lo[g.u]) + 1) *
-                     static_cast<std::uint64_t>(g.cell_v(r.box.hi[g.v]) - g.cell_v(r.box.lo[g.v]) + 1);
+        for (const SweepRef& r : refs) {
+            const CellRange c{g.cell_u(r.box.lo[g.u]), g.cell_u(r.box.hi[g.u]), g.cell_v(r.box.lo[g.v]),
+                              g.cell_v(r.box.hi[g.v])};
+            total += static_cast<std::uint64_t>(c.u1 - c.u0 + 1) * static_cast<std::uint64_t>(c.v1 - c.v0 + 1);
+            range.push_back(c);
+        }
         grid = total <= kGridMaxEntries * refs.size();
     }
     // The cells' lists (CSR, in the refs' sorted order), then units of whole cells of about
@@ -1029,21 +1038,20 @@ std::vector<std::pair<std::uint32_t, std::uint32_t>> overlapping_sets(
     std::size_t units = (refs.size() + kSweepChunk - 1) / kSweepChunk;
     if (grid) {
         const std::size_t n_cells = static_cast<std::size_t>(g.nu) * static_cast<std::size_t>(g.nv);
+        // Calls f(cell) for every cell of ref i, row by row.
+        const auto for_cells = [&](std::size_t i, auto&& f) {
+            const CellRange& c = range[i];
+            for (int cv = c.v0; cv <= c.v1; ++cv)
+                for (int cu = c.u0; cu <= c.u1; ++cu)
+                    f(static_cast<std::size_t>(cv) * static_cast<std::size_t>(g.nu) + static_cast<std::size_t>(cu));
+        };
         cell_start.assign(n_cells + 1, 0);
-        for (const SweepRef& r : refs)
-            for (int cv = g.cell_v(r.box.lo[g.v]); cv <= g.cell_v(r.box.hi[g.v]); ++cv)
-                for (int cu = g.cell_u(r.box.lo[g.u]); cu <= g.cell_u(r.box.hi[g.u]); ++cu)
-                    ++cell_start[static_cast<std::size_t>(cv) * static_cast<std::size_t>(g.nu) + static_cast<std::size_t>(cu) + 1];
+        for (std::size_t i = 0; i < refs.size(); ++i) for_cells(i, [&](std::size_t c) { ++cell_start[c + 1]; });
         for (std::size_t c = 0; c < n_cells; ++c) cell_start[c + 1] += cell_start[c];
         entries.resize(cell_start[n_cells]);
         std::vector<std::uint32_t> fill(cell_start.begin(), cell_start.end() - 1);
-        for (std::size_t i = 0; i < refs.size(); ++i) {
-            const SweepRef& r = refs[i];
-            for (int cv = g.cell_v(r.box.lo[g.v]); cv <= g.cell_v(r.box.hi[g.v]); ++cv)
-                for (int cu = g.cell_u(r.box.lo[g.u]); cu <= g.cell_u(r.box.hi[g.u]); ++cu)
-                    entries[fill[static_cast<std::size_t>(cv) * static_cast<std::size_t>(g.nu) + static_cast<std::size_t>(cu)]++] =
-                        static_cast<std::uint32_t>(i);
-        }
+        for (std::size_t i = 0; i < refs.size(); ++i)
+            for_cells(i, [&](std::size_t c) { entries[fill[c]++] = static_cast<std::uint32_t>(i); });
         unit_first.push_back(0);
         for (std::size_t c = 0; c < n_cells; ++c)
             if (cell_start[c + 1] - cell_start[unit_first.back()] >= kSweepChunk && c + 1 < n_cells) unit_first.push_back(c + 1);

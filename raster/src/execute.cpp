@@ -262,6 +262,7 @@ class CellFlags {
             b.x1 = std::max(b.x1, x1), b.y1 = std::max(b.y1, y1);
         };
         const std::uint64_t cmask = span_bits(r.x0 >> 3, r.x1 >> 3, 0);
+        const std::uint64_t m0 = span_bits(r.x0, r.x1, 0), m1 = span_bits(r.x0, r.x1, 1);
         for (int y = r.y0 >> 3; y <= r.y1 >> 3; ++y) {
             const auto c = static_cast<std::size_t>(y);
             const int fy0 = std::max(r.y0, y * 8), fy1 = std::min(r.y1, y * 8 + 7);
@@ -275,7 +276,6 @@ class CellFlags {
             // Fine flags lie only in cells flagged `some`; those inside an `all` cell are in its box
             // already, so with any `some` cell not `all`, each row's flags within r extend the box.
             if ((some_[c] & ~all_[c] & cmask) == 0) continue;
-            const std::uint64_t m0 = span_bits(r.x0, r.x1, 0), m1 = span_bits(r.x0, r.x1, 1);
             for (int fy = fy0; fy <= fy1; ++fy) {
                 const std::uint64_t* row = fine_.data() + 2 * static_cast<std::size_t>(fy);
                 const std::uint64_t w0 = row[0] & m0, w1 = row[1] & m1;
