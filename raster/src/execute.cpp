@@ -36,6 +36,9 @@ constexpr int kTileSize = kExecuteTileSize;  // llvmpipe's tile size (64); one t
 // about 100 instructions, as much as the kernel spends on a few rows (callgrind, cylinders frame:
 // shrinking every such rectangle 4.218e9 Ir, none 4.210e9, from 256 pixels up 4.182e9).
 constexpr int kShrinkMinArea = 256;
+// The fewest triangles per part of a batch's binning (bin): smaller batches are binned on the
+// calling thread.
+constexpr std::size_t kMinBinPart = 2048;
 
 detail::FrontEndParams params_for(const DepthTarget& target, RasterRules rules, const DrawState& s) {
     detail::FrontEndParams p{};
@@ -694,19 +697,28 @@ struct Ref {
     std::uint32_t tri;
 };
 
-// Binning: each tile lists the triangles overlapping it, in command order. In parallel over bands
-// of tile rows: each band walks every triangle in command order and fills only its own tiles, so
-// every bin is the same list for any thread count.
-void bin(const SetupDraws& setup, const Draws& draws, std::size_t d0, std::size_t d1, const Tiles& tiles, int threads,
-         std::vector<std::vector<Ref>>& bins) {
-    reset_lists(bins, tiles.count());
-    const int bands = threads > 1 ? std::min(threads, tiles.y) : 1;
-    detail::parallel_for(threads, static_cast<std::size_t>(bands), [&](std::size_t band) {
-        const auto n_bands = static_cast<std::size_t>(bands);
-        const int band_ty0 = static_cast<int>(static_cast<std::size_t>(tiles.y) * band / n_bands);
-        const int band_ty1 = static_cast<int>(static_cast<std::size_t>(tiles.y) * (band + 1) / n_bands) - 1;
+// Binning: each tile lists the triangles overlapping it, in command order. In parallel over
+// contiguous parts of the batch's triangles (in command order, a draw's GL-exact list then its
+// exact-bounds list): part p fills its own lists, bins[p * tiles + tile], and a tile's list is its
+// parts' lists one after another (shade), so every tile sees the same list for any number of parts.
+// Bands of tile rows, as before, made every band walk every triangle: a 2-thread batch binned no
+// faster than a 1-thread one. Returns the number of parts; `cum` is scratch.
+std::size_t bin(const SetupDraws& setup, const Draws& draws, std::size_t d0, std::size_t d1, const Tiles& tiles,
+                int threads, std::vector<std::vector<Ref>>& bins, std::vector<std::size_t>& cum) {
+    const auto count_of = [&](std::size_t d) { return setup.tris_of(d).size() + setup.bounds[d].size(); };
+    cum.resize(d1 - d0 + 1);
+    cum[0] = 0;
+    for (std::size_t d = d0; d < d1; ++d) cum[d - d0 + 1] = cum[d - d0] + count_of(d);
+    const std::size_t total = cum.back();
+    const std::size_t parts =
+        threads > 1 ? std::clamp<std::size_t>(total / kMinBinPart, 1, static_cast<std::size_t>(threads)) : 1;
+    reset_lists(bins, parts * tiles.count());
+    detail::parallel_for(threads, parts, [&](std::size_t part) {
+        std::vector<Ref>* const part_bins = bins.data() + part * tiles.count();
+        const std::size_t g0 = total * part / parts, g1 = total * (part + 1) / parts;  // [g0, g1) of the batch
+        const int top_ty = 0, bottom_ty = tiles.y - 1;  // the target's rows of tiles
         const auto add = [&](std::size_t d, std::size_t t, int tx, int ty) {
-            bins[tiles.index(tx, ty)].push_back({static_cast<std::uint32_t>(d), static_cast<std::uint32_t>(t)});
+            part_bins[tiles.index(tx, ty)].push_back({static_cast<std::uint32_t>(d), static_cast<std::uint32_t>(t)});
         };
         // The tile of a pixel coordinate. Setup's boxes lie inside the target (>= 0), so an unsigned
         // shift is the division, without the signed one's fix-up on every triangle.
@@ -716,17 +728,17 @@ void bin(const SetupDraws& setup, const Draws& draws, std::size_t d0, std::size_
         int cx0 = 0, cy0 = 0, cx1 = 0, cy1 = 0;
         const detail::PixelRect* spans = nullptr;
         const auto bin_box = [&](std::size_t d, std::size_t t, int bx0, int by0, int bx1, int by1) {
-            for (int ty = std::max({tile_of(by0), band_ty0, cy0}); ty <= std::min({tile_of(by1), band_ty1, cy1}); ++ty)
+            for (int ty = std::max({tile_of(by0), top_ty, cy0}); ty <= std::min({tile_of(by1), bottom_ty, cy1}); ++ty)
                 for (int tx = std::max(tile_of(bx0), cx0); tx <= std::min(tile_of(bx1), cx1); ++tx) add(d, t, tx, ty);
         };
-        // Draw d's GL-exact triangles into this band's tiles; with Cull, without those of the
+        // Draw d's GL-exact triangles [t0, t1) into this part's lists; with Cull, without those of the
         // facing the draw culls (share_setup left its culling to binning: CullFace::Front drops
         // front-facing triangles, CullFace::Back back-facing ones). A template, so that draws
         // without it keep a loop with no test (the test cost 0.6% of a cullide frame's instructions).
         // With Clip, only the tiles of the draw's clip; a template too (most draws have none).
         const auto bin_list = [&]<bool Cull, bool Clip>(std::size_t d, const std::vector<detail::SetupTri>& tris,
-                                                        bool drop_front) {
-            for (std::size_t t = 0; t < tris.size(); ++t) {
+                                                        std::size_t t0, std::size_t t1, bool drop_front) {
+            for (std::size_t t = t0; t < t1; ++t) {
                 const auto& tri = tris[t];
                 if constexpr (Cull) {
                     if (tri.front == drop_front) continue;
@@ -738,7 +750,7 @@ void bin(const SetupDraws& setup, const Draws& draws, std::size_t d0, std::size_
                     tx0 = std::max(tx0, cx0), tx1 = std::min(tx1, cx1);
                     if (tx0 > tx1) continue;
                 }
-                const int ty0 = std::max(tile_y0, band_ty0), ty1 = std::min(tile_y1, band_ty1);
+                const int ty0 = std::max(tile_y0, top_ty), ty1 = std::min(tile_y1, bottom_ty);
                 if (ty0 > ty1) continue;
                 if (tile_y0 == tile_y1 && tx0 == tx1) {  // one tile (most triangles at CULLIDE's sizes)
                     if constexpr (Clip) {
@@ -768,27 +780,38 @@ void bin(const SetupDraws& setup, const Draws& draws, std::size_t d0, std::size_
                 }
             }
         };
-        for (std::size_t d = d0; d < d1; ++d) {
+        // The first draw with triangles in [g0, g1): the last d with cum[d - d0] <= g0.
+        std::size_t d = d0 + static_cast<std::size_t>(std::upper_bound(cum.begin(), cum.end(), g0) - cum.begin()) - 1;
+        for (; d < d1 && cum[d - d0] < g1; ++d) {
+            const std::size_t base = cum[d - d0];
+            const std::size_t lo = std::max(g0, base) - base, hi = std::min(g1, cum[d - d0 + 1]) - base;  // [lo, hi) of d
+            if (lo >= hi) continue;
             const detail::PixelRect& clip = draws.clip[d];
             cx0 = tile_of(clip.x0), cy0 = tile_of(clip.y0), cx1 = tile_of(clip.x1), cy1 = tile_of(clip.y1);
             spans = draws.spans[d];
             const auto& tris = setup.tris_of(d);
-            const CullFace cull = setup.bin_cull[d];
-            const bool clipped = spans != nullptr;
-            if (cull == CullFace::None && !clipped)
-                bin_list.template operator()<false, false>(d, tris, false);
-            else if (cull == CullFace::None)
-                bin_list.template operator()<false, true>(d, tris, false);
-            else if (!clipped)
-                bin_list.template operator()<true, false>(d, tris, cull == CullFace::Front);
-            else
-                bin_list.template operator()<true, true>(d, tris, cull == CullFace::Front);
-            for (std::size_t t = 0; t < setup.bounds[d].size(); ++t) {
+            const std::size_t n_tris = tris.size();
+            const std::size_t t0 = std::min(lo, n_tris), t1 = std::min(hi, n_tris);
+            if (t0 < t1) {
+                const CullFace cull = setup.bin_cull[d];
+                const bool clipped = spans != nullptr;
+                if (cull == CullFace::None && !clipped)
+                    bin_list.template operator()<false, false>(d, tris, t0, t1, false);
+                else if (cull == CullFace::None)
+                    bin_list.template operator()<false, true>(d, tris, t0, t1, false);
+                else if (!clipped)
+                    bin_list.template operator()<true, false>(d, tris, t0, t1, cull == CullFace::Front);
+                else
+                    bin_list.template operator()<true, true>(d, tris, t0, t1, cull == CullFace::Front);
+            }
+            // Then its exact-bounds triangles in [lo, hi).
+            for (std::size_t t = std::max(lo, n_tris) - n_tris; t < std::max(hi, n_tris) - n_tris; ++t) {
                 const auto& tri = setup.bounds[d][t];
                 bin_box(d, t, tri.x0, tri.y0, tri.x1, tri.y1);
             }
         }
     });
+    return parts;
 }
 
 // What shade() needs of one draw, gathered once per batch (draw_infos): a bin reference then
@@ -1011,7 +1034,8 @@ Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::spa
         Draws draw_list;
         SetupDraws setup;
         std::vector<std::uint32_t> own_setup;
-        std::vector<std::vector<Ref>> bins;
+        std::vector<std::vector<Ref>> bins;  // per part of the binning, per tile (bin)
+        std::vector<std::size_t> bin_cum;
         std::vector<std::vector<std::pair<std::uint32_t, std::uint64_t>>> tile_counts;
         std::vector<std::atomic<bool>> answered;
         std::vector<detail::HizTile> hiz_tiles;
@@ -1041,8 +1065,8 @@ Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::spa
         if (k > 0 && between) between(k);
         const CommandBatch& batch = *batches[k];
         const std::size_t d0 = draw_list.first[k], d1 = draw_list.first[k + 1];
-        bin(setup, draw_list, d0, d1, tiles, threads, scratch.bins);
-        const std::vector<std::vector<Ref>>& bins = scratch.bins;
+        const std::size_t parts = bin(setup, draw_list, d0, d1, tiles, threads, scratch.bins, scratch.bin_cum);
+        std::vector<std::vector<Ref>>& bins = scratch.bins;
 
         // Back end: one task per tile.
         const std::size_t n_queries = batch.query_kinds().size();
@@ -1064,7 +1088,12 @@ Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::spa
         detail::parallel_for(threads, tiles.count(), [&](std::size_t tile) {
             const int tx = static_cast<int>(tile % static_cast<std::size_t>(tiles.x));
             const int ty = static_cast<int>(tile / static_cast<std::size_t>(tiles.x));
-            shade(ctx, tx, ty, bins[tile], tile_counts[tile]);
+            std::vector<Ref>& list = bins[tile];  // part 0's, then the later parts' in order (bin)
+            for (std::size_t p = 1; p < parts; ++p) {
+                const std::vector<Ref>& more = bins[p * tiles.count() + tile];
+                list.insert(list.end(), more.begin(), more.end());
+            }
+            shade(ctx, tx, ty, list, tile_counts[tile]);
         });
 
         QueryResults results(n_queries, 0);
