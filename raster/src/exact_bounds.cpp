@@ -1,6 +1,7 @@
 // exact_bounds.cpp: the conservative exact-bounds mode. See exact_bounds.h and
 // docs/reliable-raster.md (the error analysis behind every margin below).
 #include "exact_bounds.h"
+#include "setup_simd.h"
 
 #include <algorithm>
 #include <bit>
@@ -138,6 +139,27 @@ void classify_bounds_triangle(BoundsTri& t, const BoundsVertex* win, int n, doub
 
 }  // namespace
 
+namespace {
+
+// The end of a polygon's setup, once its box, margins and single flag are set (and it is not
+// outside the target): its per-pixel path, then the polygon (and plane) into the pool and the record
+// into `out`.
+void emit_bounds_polygon(BoundsTri& t, const BoundsVertex* win, double minx, double maxx, double miny, double maxy,
+                         std::vector<BoundsTri>& out, std::vector<BoundsVertex>& pool) {
+    BoundsPlane plane;
+    if (!t.single) classify_bounds_triangle(t, win, t.n, minx, maxx, miny, maxy, plane);
+    t.first = static_cast<std::uint32_t>(pool.size());
+    for (int i = 0; i < t.n; ++i) pool.push_back(win[i]);
+    if (t.kind == BoundsTri::Kind::Plane) {
+        const std::size_t at = pool.size();
+        pool.resize(at + kPlaneSlots);
+        std::memcpy(static_cast<void*>(pool.data() + at), &plane, sizeof plane);
+    }
+    out.push_back(t);
+}
+
+}  // namespace
+
 void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const Double4& b, const Double4& c,
                            std::uint32_t draw, std::vector<BoundsTri>& out, std::vector<BoundsVertex>& pool) {
     // M = max(1, every |coordinate|): the magnitude that scales every clip-space rounding error of
@@ -211,16 +233,59 @@ void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const
     if (box.outside(params.target_width, params.target_height)) return;
     box.cut(params.target_width, params.target_height, t.x0, t.y0, t.x1, t.y1);
     t.single = box.bx0 == box.bx1 && box.by0 == box.by1;
-    BoundsPlane plane;
-    if (!t.single) classify_bounds_triangle(t, win, n, minx, maxx, miny, maxy, plane);
-    t.first = static_cast<std::uint32_t>(pool.size());
-    for (int i = 0; i < n; ++i) pool.push_back(win[i]);
-    if (t.kind == BoundsTri::Kind::Plane) {
-        const std::size_t at = pool.size();
-        pool.resize(at + kPlaneSlots);
-        std::memcpy(static_cast<void*>(pool.data() + at), &plane, sizeof plane);
+    emit_bounds_polygon(t, win, minx, maxx, miny, maxy, out, pool);
+}
+
+void setup_bounds_range(const FrontEndParams& params, std::span<const Double4> vertices,
+                        std::span<const std::uint32_t> indices, std::uint32_t draw, std::vector<BoundsTri>& out,
+                        std::vector<BoundsVertex>& pool, bool allow_simd) {
+    const std::size_t n_tris = indices.size() / 3;
+    std::size_t k = 0;
+    if (allow_simd && kernel_avx2_available()) {
+        const Viewport& vp = params.viewport;
+        BoundsViewport bv{};
+        bv.hw = static_cast<double>(vp.width) * 0.5;
+        bv.hh = static_cast<double>(vp.height) * 0.5;
+        bv.tx = static_cast<double>(vp.x) + bv.hw;
+        bv.ty = static_cast<double>(vp.y) + bv.hh;
+        bv.hmax = std::max(bv.hw, bv.hh);
+        bv.width = params.target_width;
+        bv.height = params.target_height;
+        BoundsLanes4 io;
+        for (; k + 4 <= n_tris; k += 4) {
+            for (int t = 0; t < 4; ++t)
+                for (int c = 0; c < 3; ++c) {
+                    const Double4& v = vertices[indices[3 * (k + static_cast<std::size_t>(t)) + static_cast<std::size_t>(c)]];
+                    io.v[c][0][t] = v.x;
+                    io.v[c][1][t] = v.y;
+                    io.v[c][2][t] = v.z;
+                }
+            bounds_lanes4_avx2(io, bv);
+            for (int t = 0; t < 4; ++t) {
+                const std::size_t base = 3 * (k + static_cast<std::size_t>(t));
+                if (!((io.inside >> t) & 1u)) {  // clipped: the scalar path
+                    setup_bounds_triangle(params, vertices[indices[base]], vertices[indices[base + 1]],
+                                          vertices[indices[base + 2]], draw, out, pool);
+                    continue;
+                }
+                if ((io.outside >> t) & 1u) continue;
+                BoundsTri tri;
+                tri.n = 3;
+                tri.margin_xy = io.margin_xy[t];
+                tri.margin_z = io.margin_z[t];
+                tri.draw = draw;
+                tri.x0 = io.x0[t], tri.y0 = io.y0[t], tri.x1 = io.x1[t], tri.y1 = io.y1[t];
+                tri.single = ((io.single >> t) & 1u) != 0;
+                const BoundsVertex win[3] = {{io.win[0][0][t], io.win[0][1][t], io.win[0][2][t]},
+                                             {io.win[1][0][t], io.win[1][1][t], io.win[1][2][t]},
+                                             {io.win[2][0][t], io.win[2][1][t], io.win[2][2][t]}};
+                emit_bounds_polygon(tri, win, io.minx[t], io.maxx[t], io.miny[t], io.maxy[t], out, pool);
+            }
+        }
     }
-    out.push_back(t);
+    for (; k < n_tris; ++k)
+        setup_bounds_triangle(params, vertices[indices[3 * k]], vertices[indices[3 * k + 1]], vertices[indices[3 * k + 2]],
+                              draw, out, pool);
 }
 
 namespace {

@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <span>
 #include <vector>
 
 #include "pipeline.h"
@@ -127,6 +128,14 @@ inline BoundsPlane load_plane(const BoundsTri& t, const BoundsVertex* pool) {
 // were validated (finite, w = 1, |coordinate| <= kMaxExactBoundsCoordinate).
 void setup_bounds_triangle(const FrontEndParams& params, const Double4& a, const Double4& b, const Double4& c,
                            std::uint32_t draw, std::vector<BoundsTri>& out, std::vector<BoundsVertex>& pool);
+
+// setup_bounds_triangle for triangles (indices[3k], indices[3k + 1], indices[3k + 2]) of `vertices`,
+// k in order (the same records in the same order; validated input). With allow_simd and AVX2, four
+// triangles at a time share the common front (absolute maximum, viewport, box; setup_avx2.cpp);
+// clipped ones take the scalar path.
+void setup_bounds_range(const FrontEndParams& params, std::span<const Double4> vertices,
+                        std::span<const std::uint32_t> indices, std::uint32_t draw, std::vector<BoundsTri>& out,
+                        std::vector<BoundsVertex>& pool, bool allow_simd = true);
 
 // Rasterizes `tri` (polygon in `pool`) over `rect` (inside the target): per covered pixel the depth
 // test state.func of zmin (write) or zmax (!write) against the stored value, and the write of zmin

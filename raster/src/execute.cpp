@@ -60,11 +60,12 @@ Double4 widen(const Float4& v) {
 void setup_bounds_draw(const detail::FrontEndParams& p, const Command& c, std::uint32_t draw,
                        std::vector<detail::BoundsTri>& out, std::vector<detail::BoundsVertex>& pool) {
     const auto& idx = c.double_input ? c.mesh_d.indices : c.mesh.indices;
+    if (c.double_input) {
+        detail::setup_bounds_range(p, c.mesh_d.vertices, idx.first(idx.size() / 3 * 3), draw, out, pool);
+        return;
+    }
     for (std::size_t k = 0; k + 2 < idx.size(); k += 3) {
-        if (c.double_input) {
-            const auto& v = c.mesh_d.vertices;
-            detail::setup_bounds_triangle(p, v[idx[k]], v[idx[k + 1]], v[idx[k + 2]], draw, out, pool);
-        } else {
+        {
             const auto& v = c.mesh.vertices;
             detail::setup_bounds_triangle(p, widen(v[idx[k]]), widen(v[idx[k + 1]]), widen(v[idx[k + 2]]), draw, out,
                                           pool);

@@ -20,6 +20,8 @@
 // values whatever the instruction order.
 #include "setup_simd.h"
 
+#include "exact_bounds.h"  // the margins (kClipMarginRel, kPixelMargin, kDepthMargin)
+
 #if defined(RASTER_KERNEL_AVX2)
 #include <immintrin.h>
 #endif
@@ -264,11 +266,69 @@ void vertices8_avx2(const float* vertices, const float scale[3], const float tra
     viewport8(a, scale, translate, win);
 }
 
+// (setup_simd.h, BoundsLanes4; exact_bounds.cpp's setup_bounds_triangle is the scalar original.)
+void bounds_lanes4_avx2(BoundsLanes4& io, const BoundsViewport& vp) {
+    __m256d v[3][3];
+    const __m256d abs_mask = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffffll));
+    __m256d absmax = _mm256_setzero_pd();  // every |v| is >= +0
+    for (int k = 0; k < 3; ++k)
+        for (int c = 0; c < 3; ++c) {
+            v[k][c] = _mm256_loadu_pd(io.v[k][c]);
+            absmax = _mm256_max_pd(absmax, _mm256_and_pd(v[k][c], abs_mask));
+        }
+    const __m256d one = _mm256_set1_pd(1.0);
+    const __m256d mc = _mm256_mul_pd(_mm256_max_pd(absmax, one), _mm256_set1_pd(kClipMarginRel));
+    const __m256d lim = _mm256_add_pd(one, mc);
+    io.inside = static_cast<std::uint32_t>(_mm256_movemask_pd(_mm256_cmp_pd(absmax, lim, _CMP_LE_OQ)));
+    const __m256d hw = _mm256_set1_pd(vp.hw), hh = _mm256_set1_pd(vp.hh), tx = _mm256_set1_pd(vp.tx),
+                  ty = _mm256_set1_pd(vp.ty), half = _mm256_set1_pd(0.5);
+    __m256d w[3][3];
+    for (int k = 0; k < 3; ++k) {
+        w[k][0] = _mm256_add_pd(_mm256_mul_pd(v[k][0], hw), tx);
+        w[k][1] = _mm256_add_pd(_mm256_mul_pd(v[k][1], hh), ty);
+        w[k][2] = _mm256_add_pd(_mm256_mul_pd(v[k][2], half), half);
+        for (int c = 0; c < 3; ++c) _mm256_storeu_pd(io.win[k][c], w[k][c]);
+    }
+    // std::min(std::min(a, b), c): window coordinates are never -0 (x * hw + tx with tx >= 1/2 gives
+    // +0 for a zero sum) nor NaN, so minpd / maxpd give the same values in any operand order.
+    const __m256d minx = _mm256_min_pd(_mm256_min_pd(w[0][0], w[1][0]), w[2][0]);
+    const __m256d maxx = _mm256_max_pd(_mm256_max_pd(w[0][0], w[1][0]), w[2][0]);
+    const __m256d miny = _mm256_min_pd(_mm256_min_pd(w[0][1], w[1][1]), w[2][1]);
+    const __m256d maxy = _mm256_max_pd(_mm256_max_pd(w[0][1], w[1][1]), w[2][1]);
+    _mm256_storeu_pd(io.minx, minx);
+    _mm256_storeu_pd(io.maxx, maxx);
+    _mm256_storeu_pd(io.miny, miny);
+    _mm256_storeu_pd(io.maxy, maxy);
+    const __m256d mxy = _mm256_add_pd(_mm256_set1_pd(kPixelMargin), _mm256_mul_pd(mc, _mm256_set1_pd(vp.hmax)));
+    _mm256_storeu_pd(io.margin_xy, mxy);
+    _mm256_storeu_pd(io.margin_z, _mm256_add_pd(_mm256_set1_pd(kDepthMargin), mc));
+    // grown_box: ceil(lo - m) - 1 <= px <= floor(hi + m).
+    constexpr int kCeil = _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC, kFloor = _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC;
+    const __m256d bx0 = _mm256_sub_pd(_mm256_round_pd(_mm256_sub_pd(minx, mxy), kCeil), one);
+    const __m256d by0 = _mm256_sub_pd(_mm256_round_pd(_mm256_sub_pd(miny, mxy), kCeil), one);
+    const __m256d bx1 = _mm256_round_pd(_mm256_add_pd(maxx, mxy), kFloor);
+    const __m256d by1 = _mm256_round_pd(_mm256_add_pd(maxy, mxy), kFloor);
+    const __m256d zero = _mm256_setzero_pd();
+    const __m256d last_x = _mm256_set1_pd(static_cast<double>(vp.width - 1));
+    const __m256d last_y = _mm256_set1_pd(static_cast<double>(vp.height - 1));
+    const __m256d out = _mm256_or_pd(_mm256_or_pd(_mm256_cmp_pd(bx1, zero, _CMP_LT_OQ), _mm256_cmp_pd(by1, zero, _CMP_LT_OQ)),
+                                     _mm256_or_pd(_mm256_cmp_pd(bx0, last_x, _CMP_GT_OQ), _mm256_cmp_pd(by0, last_y, _CMP_GT_OQ)));
+    io.outside = static_cast<std::uint32_t>(_mm256_movemask_pd(out));
+    io.single = static_cast<std::uint32_t>(_mm256_movemask_pd(
+        _mm256_and_pd(_mm256_cmp_pd(bx0, bx1, _CMP_EQ_OQ), _mm256_cmp_pd(by0, by1, _CMP_EQ_OQ))));
+    // GrownBox::cut (only read for lanes inside the target, where every value is a small integer).
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(io.x0), _mm256_cvttpd_epi32(_mm256_max_pd(bx0, zero)));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(io.y0), _mm256_cvttpd_epi32(_mm256_max_pd(by0, zero)));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(io.x1), _mm256_cvttpd_epi32(_mm256_min_pd(bx1, last_x)));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(io.y1), _mm256_cvttpd_epi32(_mm256_min_pd(by1, last_y)));
+}
+
 #else
 
 void setup_lanes8_avx2(SetupLanes8&, const SetupIntRules&) {}
 void viewport_lanes8_avx2(SetupLanes8&, const float* const[24], const float[3], const float[3], bool) {}
 void vertices8_avx2(const float*, const float[3], const float[3], bool, float[3][8], std::uint32_t[8]) {}
+void bounds_lanes4_avx2(BoundsLanes4&, const BoundsViewport&) {}
 
 #endif
 

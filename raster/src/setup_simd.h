@@ -56,4 +56,25 @@ void viewport_lanes8_avx2(SetupLanes8& io, const float* const corners[24], const
 void vertices8_avx2(const float* vertices, const float scale[3], const float translate[3], bool half_z,
                     float win[3][8], std::uint32_t mask[8]);
 
+// Exact-bounds setup's common front for four unclipped triangles at once (exact_bounds.cpp,
+// setup_bounds_range): lane t = triangle t. Per lane the operations of setup_bounds_triangle in the
+// same order, each correctly rounded (no contraction), so the same doubles: the largest |coordinate|
+// and the clip margin, whether the triangle needs clipping (inside: it does not), and for the
+// unclipped ones the window corners, their ranges, the margins and the grown pixel box cut to the
+// target (exact_ceil / exact_floor as roundpd: equal but for the sign of a zero, which neither the
+// box's integers nor its compares see).
+struct BoundsLanes4 {
+    double v[3][3][4];  // in: corner k's clip x, y, z
+    double win[3][3][4];  // out: corner k's window x, y, z
+    double minx[4], maxx[4], miny[4], maxy[4];
+    double margin_xy[4], margin_z[4];
+    std::int32_t x0[4], y0[4], x1[4], y1[4];
+    std::uint32_t inside = 0, outside = 0, single = 0;  // bit t: lane t needs no clip / has no pixel / one pixel
+};
+struct BoundsViewport {
+    double hw, hh, tx, ty, hmax;  // the viewport map's scale and offset, max(hw, hh)
+    int width, height;            // the target
+};
+void bounds_lanes4_avx2(BoundsLanes4& io, const BoundsViewport& vp);
+
 }  // namespace raster::detail

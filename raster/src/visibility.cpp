@@ -331,24 +331,19 @@ bool VisibilityPass::State::setup_item(const detail::FrontEndParams& params, std
     area[i] = 0;
     if (skip[i]) return true;  // alone in the view: no triangle to draw (alone())
     const std::size_t nv = m.vertices.size();
-    for (std::size_t k = 0; k + 2 < m.indices.size(); k += 3) {
+    const std::size_t n_idx = m.indices.size() / 3 * 3;
+    for (std::size_t k = 0; k < n_idx; k += 3) {  // the input checks first (a failed item is not drawn)
         const std::uint32_t ia = m.indices[k], ib = m.indices[k + 1], ic = m.indices[k + 2];
-        if (ia >= nv || ib >= nv || ic >= nv) {
+        if (ia >= nv || ib >= nv || ic >= nv ||
+            !(valid_vertex(m.vertices[ia]) && valid_vertex(m.vertices[ib]) && valid_vertex(m.vertices[ic]))) {
             bad[i] = 1;
             return false;
-        }
-        const Double4 &a = m.vertices[ia], &b = m.vertices[ib], &c = m.vertices[ic];
-        if (!(valid_vertex(a) && valid_vertex(b) && valid_vertex(c))) {
-            bad[i] = 1;
-            return false;
-        }
-        const std::size_t before = item_tris.size();
-        detail::setup_bounds_triangle(params, a, b, c, static_cast<std::uint32_t>(i), item_tris, item_pool);
-        if (item_tris.size() != before) {
-            const detail::BoundsTri& t = item_tris.back();
-            area[i] += static_cast<std::uint64_t>(t.x1 - t.x0 + 1) * static_cast<std::uint64_t>(t.y1 - t.y0 + 1);
         }
     }
+    detail::setup_bounds_range(params, m.vertices, m.indices.first(n_idx), static_cast<std::uint32_t>(i), item_tris,
+                               item_pool);
+    for (const detail::BoundsTri& t : item_tris)
+        area[i] += static_cast<std::uint64_t>(t.x1 - t.x0 + 1) * static_cast<std::uint64_t>(t.y1 - t.y0 + 1);
     return true;
 }
 
@@ -911,44 +906,54 @@ Result<std::size_t> WindowedPasses::prepare(int width, int height, DepthFormat f
             const auto begin = static_cast<std::uint32_t>(ch.records.size());
             const auto tag = static_cast<std::uint32_t>(i + 1);
             const std::size_t nv = m.vertices.size();
-            for (std::uint64_t tri = k0; tri < k1; ++tri) {
-                const std::size_t k = static_cast<std::size_t>(tri) * 3;
-                const std::uint32_t ia = m.indices[k], ib = m.indices[k + 1], ic = m.indices[k + 2];
-                if (ia >= nv || ib >= nv || ic >= nv || !valid_vertex(m.vertices[ia]) || !valid_vertex(m.vertices[ib]) ||
-                    !valid_vertex(m.vertices[ic])) {
+            // Runs of up to kSetupRun triangles: checked, set up together (setup_bounds_range: four
+            // at a time with AVX2), then drawn in order, one record per triangle that has a pixel.
+            constexpr std::uint64_t kSetupRun = 64;
+            bool failed = false;
+            for (std::uint64_t run = k0; run < k1 && !failed; run += kSetupRun) {
+                const std::uint64_t run_end = std::min(k1, run + kSetupRun);
+                for (std::uint64_t tri = run; tri < run_end && !failed; ++tri) {
+                    const std::size_t k = static_cast<std::size_t>(tri) * 3;
+                    const std::uint32_t ia = m.indices[k], ib = m.indices[k + 1], ic = m.indices[k + 2];
+                    failed = ia >= nv || ib >= nv || ic >= nv || !valid_vertex(m.vertices[ia]) ||
+                             !valid_vertex(m.vertices[ib]) || !valid_vertex(m.vertices[ic]);
+                }
+                if (failed) {
                     s.bad[i] = 1;  // (only ever set to 1: chunks sharing an item agree)
                     break;
                 }
                 ch.tris.clear();
                 ch.pool.clear();
-                detail::setup_bounds_triangle(params, m.vertices[ia], m.vertices[ib], m.vertices[ic],
-                                              static_cast<std::uint32_t>(i), ch.tris, ch.pool);
-                if (ch.tris.empty()) continue;
-                const detail::BoundsTri& t = ch.tris.front();
-                const double mz = t.margin_z;
-                double last_lo = std::numeric_limits<double>::quiet_NaN(), last_hi = last_lo;
-                std::uint32_t zmin = 0, zmax = 0;  // quantized once per distinct depth
-                detail::bounds_pixels(t, ch.pool.data(), detail::PixelRect{t.x0, t.y0, t.x1, t.y1},
-                                      [&](int px, int py, double zlo, double zhi) {
-                                          if (!(zlo == last_lo)) {
-                                              last_lo = zlo;
-                                              zmin = detail::quantize_down(zlo - mz, format);
-                                          }
-                                          if (!(zhi == last_hi)) {
-                                              last_hi = zhi;
-                                              zmax = detail::quantize_up(zhi + mz, format);
-                                          }
-                                          const auto p = static_cast<std::uint32_t>(py * width + px);
-                                          if (ch.stamp[p] != tag) {
-                                              ch.stamp[p] = tag;
-                                              ch.slot[p] = static_cast<std::uint32_t>(ch.records.size());
-                                              ch.records.push_back({p, zmin, zmax});
-                                          } else {
-                                              PixelRecord& r = ch.records[ch.slot[p]];
-                                              r.zmin = std::min(r.zmin, zmin);
-                                              r.zmax = std::max(r.zmax, zmax);
-                                          }
-                                      });
+                detail::setup_bounds_range(params, m.vertices,
+                                           m.indices.subspan(static_cast<std::size_t>(run) * 3,
+                                                             static_cast<std::size_t>(run_end - run) * 3),
+                                           static_cast<std::uint32_t>(i), ch.tris, ch.pool);
+                for (const detail::BoundsTri& t : ch.tris) {
+                    const double mz = t.margin_z;
+                    double last_lo = std::numeric_limits<double>::quiet_NaN(), last_hi = last_lo;
+                    std::uint32_t zmin = 0, zmax = 0;  // quantized once per distinct depth
+                    detail::bounds_pixels(t, ch.pool.data(), detail::PixelRect{t.x0, t.y0, t.x1, t.y1},
+                                          [&](int px, int py, double zlo, double zhi) {
+                                              if (!(zlo == last_lo)) {
+                                                  last_lo = zlo;
+                                                  zmin = detail::quantize_down(zlo - mz, format);
+                                              }
+                                              if (!(zhi == last_hi)) {
+                                                  last_hi = zhi;
+                                                  zmax = detail::quantize_up(zhi + mz, format);
+                                              }
+                                              const auto p = static_cast<std::uint32_t>(py * width + px);
+                                              if (ch.stamp[p] != tag) {
+                                                  ch.stamp[p] = tag;
+                                                  ch.slot[p] = static_cast<std::uint32_t>(ch.records.size());
+                                                  ch.records.push_back({p, zmin, zmax});
+                                              } else {
+                                                  PixelRecord& r = ch.records[ch.slot[p]];
+                                                  r.zmin = std::min(r.zmin, zmin);
+                                                  r.zmax = std::max(r.zmax, zmax);
+                                              }
+                                          });
+                }
             }
             ch.segments.push_back({static_cast<std::uint32_t>(i), begin, static_cast<std::uint32_t>(ch.records.size())});
         }

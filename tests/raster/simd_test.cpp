@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "exact_bounds.h"
 #include "pipeline.h"
 #include "raster/raster.h"
 #include "scene_gen.h"
@@ -1099,4 +1100,101 @@ TEST_CASE("setup_range (each vertex transformed once, 8 triangles at a time) == 
     // The cases the viewports are for happened.
     CHECK(cut > 100);
     CHECK(wide > 20);
+}
+
+TEST_CASE("setup_bounds_range (four triangles at a time with AVX2) == setup_bounds_triangle per triangle") {
+    // Exact-bounds setup: every BoundsTri field and every pool value must be the scalar code's bits.
+    // The vertices cover what decides the common front (setup_avx2.cpp, bounds_lanes4_avx2): tiny
+    // triangles inside one pixel, corners on pixel edges and on half pixels (ceil / floor of exact
+    // integers, single-pixel boxes), -0 coordinates, corners beyond the clip volume mixed into the
+    // same group of four (they take the scalar path), triangles outside the target, degenerate ones,
+    // large magnitudes up to kMaxExactBoundsCoordinate, viewports that are not the target, and counts
+    // that are not multiples of four.
+    raster_test::SplitMix64 rng(24681);
+    std::size_t compared = 0, singles = 0, clipped_groups = 0, planes = 0;
+    const auto coord = [&](int n, double lo, double hi) -> double {
+        switch (rng.below(8)) {
+            case 0: return -0.0;
+            case 1: return 2.0 * static_cast<double>(std::floor(rng.uniform(0.0f, static_cast<float>(n)))) / n - 1.0;  // a pixel edge
+            case 2: return (2.0 * static_cast<double>(std::floor(rng.uniform(0.0f, static_cast<float>(n)))) + 1.0) / n - 1.0;  // a centre
+            case 3: return rng.chance(50) ? 1.0 : -1.0;
+            default: return lo + (hi - lo) * static_cast<double>(rng.uniform(0.0f, 1.0f));
+        }
+    };
+    for (int round = 0; round < 400; ++round) {
+        const int w = 16 + static_cast<int>(rng.below(48)), h = 16 + static_cast<int>(rng.below(48));
+        detail::FrontEndParams p = whole_target(w, h);
+        if (round % 4 == 3) {
+            p.viewport.width = w / 2 + static_cast<int>(rng.below(static_cast<std::uint32_t>(2 * w)));
+            p.viewport.height = h / 2 + static_cast<int>(rng.below(static_cast<std::uint32_t>(2 * h)));
+            p.viewport.x = static_cast<int>(rng.below(static_cast<std::uint32_t>(w))) - w / 2;
+            p.viewport.y = static_cast<int>(rng.below(static_cast<std::uint32_t>(h))) - h / 2;
+        }
+        std::vector<raster::Double4> v;
+        const std::size_t n_tris = 1 + rng.below(40);
+        for (std::size_t t = 0; t < n_tris; ++t) {
+            const std::uint32_t kind = rng.below(10);
+            const double cx = coord(w, -1.1, 1.1), cy = coord(h, -1.1, 1.1), cz = coord(4, -1.0, 1.0);
+            for (int k = 0; k < 3; ++k) {
+                raster::Double4 c{cx, cy, cz, 1.0};
+                if (kind < 4) {  // within a pixel or two
+                    c.x += static_cast<double>(rng.uniform(-1.5f, 1.5f)) / w;
+                    c.y += static_cast<double>(rng.uniform(-1.5f, 1.5f)) / h;
+                } else if (kind < 6) {  // anywhere (some beyond the clip volume)
+                    c = {coord(w, -1.3, 1.3), coord(h, -1.3, 1.3), coord(2, -1.2, 1.2), 1.0};
+                } else if (kind == 6) {  // huge
+                    c.x = (rng.chance(50) ? 1.0 : -1.0) * raster::kMaxExactBoundsCoordinate * static_cast<double>(rng.uniform(0.0f, 1.0f));
+                } else if (kind == 7) {  // degenerate: every corner the same point
+                } else {  // a few pixels
+                    c.x += static_cast<double>(rng.uniform(-6.0f, 6.0f)) / w;
+                    c.y += static_cast<double>(rng.uniform(-6.0f, 6.0f)) / h;
+                    c.z += static_cast<double>(rng.uniform(-0.1f, 0.1f));
+                }
+                v.push_back(c);
+            }
+        }
+        std::vector<std::uint32_t> idx(v.size());
+        for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = static_cast<std::uint32_t>(i);
+        if (rng.chance(30)) std::reverse(idx.begin(), idx.end());  // indexed out of order
+        std::vector<detail::BoundsTri> want, got;
+        std::vector<detail::BoundsVertex> want_pool, got_pool;
+        for (std::size_t k = 0; k < idx.size(); k += 3)
+            detail::setup_bounds_triangle(p, v[idx[k]], v[idx[k + 1]], v[idx[k + 2]], 5, want, want_pool);
+        detail::setup_bounds_range(p, v, idx, 5, got, got_pool);
+        for (std::size_t g = 0; g + 4 <= n_tris; g += 4) {
+            bool any = false;
+            for (std::size_t k = 3 * g; k < 3 * g + 12; ++k)
+                any = any || std::max({std::fabs(v[idx[k]].x), std::fabs(v[idx[k]].y), std::fabs(v[idx[k]].z)}) > 1.0;
+            clipped_groups += any ? 1u : 0u;
+        }
+        REQUIRE(want.size() == got.size());
+        REQUIRE(want_pool.size() == got_pool.size());
+        const auto dbits = [](double d) { return std::bit_cast<std::uint64_t>(d); };
+        for (std::size_t i = 0; i < want.size(); ++i) {
+            const auto& a = want[i];
+            const auto& b = got[i];
+            CHECK((a.first == b.first && a.n == b.n && dbits(a.margin_xy) == dbits(b.margin_xy) &&
+                   dbits(a.margin_z) == dbits(b.margin_z) && a.x0 == b.x0 && a.y0 == b.y0 && a.x1 == b.x1 &&
+                   a.y1 == b.y1 && a.draw == b.draw && a.single == b.single && a.zq_lo == b.zq_lo &&
+                   a.zq_hi == b.zq_hi && a.kind == b.kind));
+            singles += a.single ? 1u : 0u;
+            planes += a.kind == detail::BoundsTri::Kind::Plane ? 1u : 0u;
+        }
+        for (std::size_t i = 0; i < want_pool.size(); ++i)
+            CHECK((dbits(want_pool[i].x) == dbits(got_pool[i].x) && dbits(want_pool[i].y) == dbits(got_pool[i].y) &&
+                   dbits(want_pool[i].z) == dbits(got_pool[i].z)));
+        compared += want.size();
+        // Scalar only (allow_simd off) is the same list too.
+        std::vector<detail::BoundsTri> scalar;
+        std::vector<detail::BoundsVertex> scalar_pool;
+        detail::setup_bounds_range(p, v, idx, 5, scalar, scalar_pool, false);
+        CHECK(scalar.size() == want.size());
+        CHECK(scalar_pool.size() == want_pool.size());
+    }
+    MESSAGE("AVX2 exact-bounds setup: " << std::string(detail::kernel_avx2_available() ? "on" : "off (scalar both sides)"));
+    CHECK(compared > 3000);
+    // The cases the inputs are for happened.
+    CHECK(singles > 300);
+    CHECK(planes > 100);
+    CHECK(clipped_groups > 100);
 }
