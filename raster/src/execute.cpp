@@ -1,7 +1,5 @@
 // execute.cpp: the scalar reference executor and the tiled (optionally multithreaded) executor.
 #include <algorithm>
-#include <chrono>
-#include <cstdio>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -1124,10 +1122,7 @@ Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::spa
     // batch with the same spans and front-end state (share_setup). Every batch's spans are alive
     // and unchanged for the whole call (the lifetime rule of raster/types.h), so this is exact.
     draws(batches, threads, draw_list, target, options);
-    { static double acc = 0; static long n = 0; struct P { ~P(){ if(getenv("TTLOG")) fprintf(stderr,"SHARE %.2f ms %ld calls\n", acc, n);} }; static P pr;
-      auto a = std::chrono::steady_clock::now();
     share_setup(target, draw_list, scratch.setup, scratch.setup_index);
-      acc += std::chrono::duration<double,std::milli>(std::chrono::steady_clock::now()-a).count(); ++n; }
     front_end(target, draw_list, threads, scratch.setup, scratch.own_setup);
     const SetupDraws& setup = scratch.setup;
     const Tiles tiles{(target.width() + kTileSize - 1) / kTileSize, (target.height() + kTileSize - 1) / kTileSize};
