@@ -62,13 +62,9 @@ void setup_bounds_draw(const detail::FrontEndParams& p, const Command& c, std::u
         detail::setup_bounds_range(p, c.mesh_d.vertices, idx.first(idx.size() / 3 * 3), draw, out, pool);
         return;
     }
-    for (std::size_t k = 0; k + 2 < idx.size(); k += 3) {
-        {
-            const auto& v = c.mesh.vertices;
-            detail::setup_bounds_triangle(p, widen(v[idx[k]]), widen(v[idx[k + 1]]), widen(v[idx[k + 2]]), draw, out,
-                                          pool);
-        }
-    }
+    const auto& v = c.mesh.vertices;  // float input, widened exactly
+    for (std::size_t k = 0; k + 2 < idx.size(); k += 3)
+        detail::setup_bounds_triangle(p, widen(v[idx[k]]), widen(v[idx[k + 1]]), widen(v[idx[k + 2]]), draw, out, pool);
 }
 
 // CULLIDE_RASTER_NO_HIZ set to anything but "" or "0" turns hierarchical Z off (read once).
