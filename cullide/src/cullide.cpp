@@ -677,24 +677,7 @@ std::vector<Aabb> object_bounds(std::span<const Mesh> objects, std::span<const s
     }
     std::vector<Aabb> job_box(jobs.size());
     parallel_chunks(threads, jobs.size(), [&](std::size_t j) {
-        const Mesh& m = objects[active[jobs[j].k]];
-        const Vec3* const pos = m.positions.data();
-        // mesh_bounds' loop over [first, last): the first vertex, then std::min / std::max with every
-        // vertex of every triangle in order, six doubles in registers.
-        const Vec3& p0 = pos[m.triangles[jobs[j].first][0]];
-        double x0 = p0.x, y0 = p0.y, z0 = p0.z, x1 = p0.x, y1 = p0.y, z1 = p0.z;
-        for (std::size_t t = jobs[j].first; t < jobs[j].last; ++t) {
-            for (const std::uint32_t v : m.triangles[t]) {
-                const Vec3& p = pos[v];
-                x0 = std::min(x0, p.x);
-                y0 = std::min(y0, p.y);
-                z0 = std::min(z0, p.z);
-                x1 = std::max(x1, p.x);
-                y1 = std::max(y1, p.y);
-                z1 = std::max(z1, p.z);
-            }
-        }
-        job_box[j] = {{x0, y0, z0}, {x1, y1, z1}};
+        job_box[j] = triangles_bounds(objects[active[jobs[j].k]], jobs[j].first, jobs[j].last);
     });
     // In job order: unite takes the first job's box as it is (the empty box is its identity), then
     // std::min / std::max with the box so far first.

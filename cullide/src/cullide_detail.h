@@ -61,6 +61,10 @@ inline constexpr std::size_t kTransformPart = 4096;
                                                        const VisibilityOptions& o, VisibilityMode mode,
                                                        bool scene_checked = false);
 
+// The box of triangles [first, last) of `mesh`'s vertices (empty when first >= last): mesh_bounds is
+// this over every triangle, and object_bounds over parts that it unites in order (the same bits).
+[[nodiscard]] Aabb triangles_bounds(const Mesh& mesh, std::size_t first, std::size_t last);
+
 // Every active object's mesh_bounds (the union of its triangles' boxes; empty without triangles), in
 // jobs of at most kBoundsTriangles triangles on `threads` workers, folded in job order. std::min and
 // std::max keep the earlier of equal values, so the boxes are mesh_bounds' bits (signed zeros

@@ -1,5 +1,7 @@
 #include "cullide/mesh.h"
 
+#include "cullide_detail.h"
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -19,20 +21,27 @@ Aabb triangle_bounds(const Mesh& mesh, std::size_t triangle) {
     return box;
 }
 
-Aabb mesh_bounds(const Mesh& mesh) {
-    Aabb box;
-    bool first = true;
-    for (const Tri& t : mesh.triangles) {
-        for (std::uint32_t v : t) {
-            const Vec3& p = mesh.positions[v];
-            for (int k = 0; k < 3; ++k) {
-                box.lo[k] = first ? p[k] : std::min(box.lo[k], p[k]);
-                box.hi[k] = first ? p[k] : std::max(box.hi[k], p[k]);
-            }
-            first = false;
+Aabb mesh_bounds(const Mesh& mesh) { return detail::triangles_bounds(mesh, 0, mesh.triangles.size()); }
+
+Aabb detail::triangles_bounds(const Mesh& mesh, std::size_t first, std::size_t last) {
+    if (first >= last) return Aabb{};
+    // The first vertex, then std::min / std::max with every vertex of every triangle in order (the
+    // earlier of equal values kept, signed zeros included), six doubles in registers.
+    const Vec3* const pos = mesh.positions.data();
+    const Vec3& p0 = pos[mesh.triangles[first][0]];
+    double x0 = p0.x, y0 = p0.y, z0 = p0.z, x1 = p0.x, y1 = p0.y, z1 = p0.z;
+    for (std::size_t t = first; t < last; ++t) {
+        for (const std::uint32_t v : mesh.triangles[t]) {
+            const Vec3& p = pos[v];
+            x0 = std::min(x0, p.x);
+            y0 = std::min(y0, p.y);
+            z0 = std::min(z0, p.z);
+            x1 = std::max(x1, p.x);
+            y1 = std::max(y1, p.y);
+            z1 = std::max(z1, p.z);
         }
     }
-    return box;
+    return Aabb{{x0, y0, z0}, {x1, y1, z1}};
 }
 
 namespace {
