@@ -82,8 +82,28 @@ inline constexpr std::size_t kBoundsTriangles = 8192;
 inline constexpr std::size_t kCheckPart = 16384;
 [[nodiscard]] bool scene_clean(std::span<const Mesh> objects, int threads);
 
+// What Quick-CULLIDE's self stage may keep from one frame to the next (FrameContext): per object
+// index, the triangle order it chose and that order's window, with the topology they are a function
+// of (the triangles, the welded vertex ids and the group size). An entry is used only when all three
+// are equal to the frame's, so a frame's results are the same with it, without it, or with one that
+// other scenes filled. The order costs two breadth-first searches and two window scans per object
+// per frame (about 10% of a `qcullide --self` cloth frame, on the calling thread alone), while a
+// deforming mesh's topology, and so its order, rarely changes from frame to frame.
+struct QuickSelfCache {
+    struct Entry {
+        std::vector<Tri> triangles;
+        std::vector<std::uint32_t> weld;
+        std::size_t group = 0;
+        std::vector<std::uint32_t> order;
+        std::uint32_t window = 0;
+        bool valid = false;
+    };
+    std::vector<Entry> entries;  // by object index
+};
+
 // cullide_pairs and quick_cullide_pairs for a caller that has checked the scene (scene_checked as
-// above); the public functions are these with scene_checked = false.
+// above); the public functions are these with scene_checked = false. `self_cache` (optional): see
+// QuickSelfCache.
 [[nodiscard]] Result<std::vector<TrianglePair>> cullide_pairs(std::span<const Mesh> objects,
                                                               std::span<const std::uint32_t> active,
                                                               const CullideOptions& options, QueryDevice& device,
@@ -91,7 +111,8 @@ inline constexpr std::size_t kCheckPart = 16384;
 [[nodiscard]] Result<std::vector<TrianglePair>> quick_cullide_pairs(std::span<const Mesh> objects,
                                                                     std::span<const std::uint32_t> active,
                                                                     const QuickOptions& options, QueryDevice& device,
-                                                                    QuickStats* stats, bool scene_checked);
+                                                                    QuickStats* stats, bool scene_checked,
+                                                                    QuickSelfCache* self_cache = nullptr);
 
 // The order of one recorded Quick-CULLIDE pass over n items (quick_cullide.cpp, and the recorded
 // form of raster::WindowedPasses): forward, for k = 0 .. n-1, query(k), then write(d) for every item

@@ -22,6 +22,7 @@ namespace cullide {
 // that runs on it and kept with its depth target.
 struct FrameContext::State {
     std::unique_ptr<detail::EmulatorDevice> device;
+    detail::QuickSelfCache quick_self;  // used only where the frame's topology equals its entry's
 };
 
 FrameContext::FrameContext() : state_(std::make_unique<State>()) {}
@@ -152,7 +153,8 @@ Status run_visibility(std::span<const Mesh> objects, const std::vector<std::uint
         qo.mode = o.method == Method::QCullide ? VisibilityMode::ExactBounds : VisibilityMode::GLExact;
         qo.self = o.self;
         QuickStats qs;
-        pairs = detail::quick_cullide_pairs(objects, active, qo, *device, &qs, true);  // checked by process_frame
+        pairs = detail::quick_cullide_pairs(objects, active, qo, *device, &qs, true,  // checked by process_frame
+                                            &context.quick_self);
         static_cast<VisibilityStats&>(st) = std::move(qs);
         st.subobject_pairs = qs.item_pairs_kept;
         // With self-collision no object leaves at object level (it may collide with itself).

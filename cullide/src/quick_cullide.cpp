@@ -585,24 +585,44 @@ Status separate_stages(std::span<const Mesh> objects, std::span<const std::uint3
 // their overlapping box pairs (BFV items included: their near pairs stay open).
 Status self_stage(std::span<const Mesh> objects, std::span<const std::uint32_t> active, const QuickOptions& options,
                   ViewSize size, QueryDevice& device, std::vector<Geom>& geoms, std::vector<Item>& items,
-                  std::vector<ItemPair>& overlapping, QuickStats& st) {
+                  std::vector<ItemPair>& overlapping, QuickStats& st, detail::QuickSelfCache* cache) {
     const auto group = static_cast<std::size_t>(options.subobject_triangles);
     auto t0 = Clock::now();
+    if (cache != nullptr && cache->entries.size() < objects.size()) cache->entries.resize(objects.size());
     for (std::uint32_t object : active) {
         const Mesh& m = objects[object];
         std::vector<std::uint32_t> weld = weld_vertices(m);
-        const VertexTriangles vt = vertex_triangles(m, weld);
-        std::vector<std::uint32_t> input(m.triangles.size());
-        for (std::size_t t = 0; t < input.size(); ++t) input[t] = static_cast<std::uint32_t>(t);
-        std::vector<std::uint32_t> last;
-        (void)bfs_order(m, weld, vt, {}, &last);
-        std::vector<std::uint32_t> bfs = bfs_order(m, weld, vt, last, nullptr);
-        const std::uint32_t w_in = window_of(input, group, vt);
-        const std::uint32_t w_bfs = window_of(bfs, group, vt);
-        const std::uint32_t w = std::min(w_in, w_bfs);
+        std::vector<std::uint32_t> order;
+        std::uint32_t w = 0;
+        detail::QuickSelfCache::Entry* entry = cache != nullptr ? &cache->entries[object] : nullptr;
+        if (entry != nullptr && entry->valid && entry->group == group && entry->weld == weld &&
+            entry->triangles == m.triangles) {
+            order = entry->order;  // the same topology: the order below would be this one
+            w = entry->window;
+        } else {
+            const VertexTriangles vt = vertex_triangles(m, weld);
+            std::vector<std::uint32_t> input(m.triangles.size());
+            for (std::size_t t = 0; t < input.size(); ++t) input[t] = static_cast<std::uint32_t>(t);
+            std::vector<std::uint32_t> last;
+            (void)bfs_order(m, weld, vt, {}, &last);
+            std::vector<std::uint32_t> bfs = bfs_order(m, weld, vt, last, nullptr);
+            const std::uint32_t w_in = window_of(input, group, vt);
+            const std::uint32_t w_bfs = window_of(bfs, group, vt);
+            w = std::min(w_in, w_bfs);
+            order = w_bfs < w_in ? std::move(bfs) : std::move(input);
+            if (entry != nullptr) {
+                entry->valid = false;  // (until every field below is set)
+                entry->triangles = m.triangles;
+                entry->weld = weld;
+                entry->group = group;
+                entry->order = order;
+                entry->window = w;
+                entry->valid = true;
+            }
+        }
         st.window_max = std::max<std::uint64_t>(st.window_max, w);
         const auto gi = static_cast<std::uint32_t>(geoms.size());
-        geoms.push_back(make_mesh_geom(m, object, w_bfs < w_in ? std::move(bfs) : std::move(input)));
+        geoms.push_back(make_mesh_geom(m, object, std::move(order)));
         geoms.back().weld = std::move(weld);
         Item whole;
         whole.geom = gi;
@@ -641,7 +661,8 @@ Result<std::vector<TrianglePair>> quick_cullide_pairs(std::span<const Mesh> obje
 Result<std::vector<TrianglePair>> detail::quick_cullide_pairs(std::span<const Mesh> objects,
                                                               std::span<const std::uint32_t> active,
                                                               const QuickOptions& options, QueryDevice& device,
-                                                              QuickStats* stats, bool scene_checked) {
+                                                              QuickStats* stats, bool scene_checked,
+                                                              detail::QuickSelfCache* self_cache) {
     Result<ViewSize> checked = check_inputs(objects, active, options, scene_checked);
     if (!checked) return checked.error();
     const ViewSize size = checked.value();
@@ -652,7 +673,8 @@ Result<std::vector<TrianglePair>> detail::quick_cullide_pairs(std::span<const Me
     std::vector<ItemPair> overlapping;
 
     const Status ran = options.self
-                           ? self_stage(objects, active, options, size, device, geoms, items, overlapping, st)
+                           ? self_stage(objects, active, options, size, device, geoms, items, overlapping, st,
+                                        self_cache)
                            : separate_stages(objects, active, options, size, device, geoms, items, st);
     if (!ran) return ran.error();
 

@@ -1,17 +1,23 @@
 // FrameContext (cullide/pipeline.h): a context reused across frames gives the same bits as a fresh
 // call, whatever ran through it before (methods, resolutions, depth formats, scene sizes, thread
-// counts, failed frames), and it is movable. The emulator device's partial clear (it restores only
+// counts, failed frames), and it is movable; Quick-CULLIDE's self order kept in it is used only for
+// the topology it came from. The emulator device's partial clear (it restores only
 // the tiles where raster::execute ran writing draws) leaves the whole target at depth 1.0, as a
 // full clear does.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "cullide/ground_truth.h"
 #include "cullide/pipeline.h"
+#include "cullide/quick_cullide.h"
 #include "cullide/scenes.h"
+#include "cullide_detail.h"
 #include "emulator_device.h"
 #include "test_rng.h"
 
@@ -131,6 +137,112 @@ TEST_CASE("A reused FrameContext gives every frame of a mixed sequence the bits 
         REQUIRE_MESSAGE(other.ok(), other.error().message);
         check_same(other.value(), fresh.value());
     }
+}
+
+namespace {
+
+struct QuickRun {
+    std::vector<cullide::TrianglePair> pairs;
+    cullide::QuickStats stats;
+};
+
+QuickRun quick_self(const std::vector<Mesh>& objects, int group, cullide::detail::QuickSelfCache* cache) {
+    std::vector<std::uint32_t> active(objects.size());
+    for (std::size_t i = 0; i < active.size(); ++i) active[i] = static_cast<std::uint32_t>(i);
+    cullide::QuickOptions o;
+    o.self = true;
+    o.subobject_triangles = group;
+    o.threads = 2;
+    cullide::detail::EmulatorDevice device(2);
+    QuickRun r;
+    auto got = cullide::detail::quick_cullide_pairs(objects, active, o, device, &r.stats, false, cache);
+    REQUIRE_MESSAGE(got.ok(), got.error().message);
+    r.pairs = std::move(got).value();
+    return r;
+}
+
+void check_same_quick(const QuickRun& got, const QuickRun& want) {
+    CHECK(got.pairs == want.pairs);
+    CHECK(got.stats.window_max == want.stats.window_max);
+    CHECK(got.stats.item_pairs == want.stats.item_pairs);
+    CHECK(got.stats.item_pairs_kept == want.stats.item_pairs_kept);
+    CHECK(got.stats.near_item_pairs == want.stats.near_item_pairs);
+    CHECK(got.stats.near_exact_tests == want.stats.near_exact_tests);
+    CHECK(got.stats.exact_tests == want.stats.exact_tests);
+    CHECK(got.stats.pcs_subobjects == want.stats.pcs_subobjects);
+    CHECK(got.stats.queries == want.stats.queries);
+    REQUIRE(got.stats.views.size() == want.stats.views.size());
+    for (std::size_t v = 0; v < got.stats.views.size(); ++v) {
+        CAPTURE(v);
+        CHECK(got.stats.views[v].axis == want.stats.views[v].axis);
+        CHECK(got.stats.views[v].items_after == want.stats.views[v].items_after);
+    }
+}
+
+// What check_same_quick compares, as one answer.
+bool same_quick(const QuickRun& a, const QuickRun& b) {
+    bool same = a.pairs == b.pairs && a.stats.window_max == b.stats.window_max &&
+                a.stats.item_pairs == b.stats.item_pairs && a.stats.item_pairs_kept == b.stats.item_pairs_kept &&
+                a.stats.near_item_pairs == b.stats.near_item_pairs &&
+                a.stats.near_exact_tests == b.stats.near_exact_tests && a.stats.exact_tests == b.stats.exact_tests &&
+                a.stats.pcs_subobjects == b.stats.pcs_subobjects && a.stats.queries == b.stats.queries &&
+                a.stats.views.size() == b.stats.views.size();
+    for (std::size_t v = 0; same && v < a.stats.views.size(); ++v)
+        same = a.stats.views[v].axis == b.stats.views[v].axis && a.stats.views[v].items_after == b.stats.views[v].items_after;
+    return same;
+}
+
+}  // namespace
+
+TEST_CASE("Quick-CULLIDE's self order kept between frames is used only for the topology it came from") {
+    // The folded sheet (views run and pairs are found) and three changes of what the order is a
+    // function of: the welded ids (two corners of the sheet moved onto one point, so that the
+    // first and last triangles become neighbours), the triangle list (shuffled) and the group size.
+    const std::vector<Mesh> base = {scene_frame("cloth", 0.1, 55)[0]};  // the sheet alone
+    std::vector<Mesh> welded = base;
+    welded[0].positions.back() = welded[0].positions.front();
+    std::vector<Mesh> shuffled = base;  // the same triangles in another list order
+    {
+        test::Rng rng(20261128);
+        auto& t = shuffled[0].triangles;
+        for (std::size_t i = t.size() - 1; i > 0; --i) std::swap(t[i], t[rng.below(i + 1)]);
+    }
+    const QuickRun fresh_base = quick_self(base, 4, nullptr);
+    const QuickRun fresh_welded = quick_self(welded, 4, nullptr);
+    const QuickRun fresh_shuffled = quick_self(shuffled, 4, nullptr);
+    const QuickRun fresh_group2 = quick_self(base, 2, nullptr);
+    REQUIRE_FALSE(fresh_base.pairs.empty());
+    REQUIRE(fresh_base.stats.queries > 0);
+
+    cullide::detail::QuickSelfCache cache;
+    const struct {
+        const std::vector<Mesh>* objects;
+        int group;
+        const QuickRun* want;
+    } steps[] = {{&base, 4, &fresh_base},     {&base, 4, &fresh_base},         {&welded, 4, &fresh_welded},
+                 {&base, 4, &fresh_base},     {&shuffled, 4, &fresh_shuffled}, {&base, 2, &fresh_group2},
+                 {&base, 4, &fresh_base},     {&welded, 4, &fresh_welded},     {&welded, 4, &fresh_welded}};
+    for (std::size_t i = 0; i < std::size(steps); ++i) {
+        CAPTURE(i);
+        check_same_quick(quick_self(*steps[i].objects, steps[i].group, &cache), *steps[i].want);
+    }
+
+    // The checks above would see an entry used for the wrong topology, and the entry is read when
+    // its topology matches: the base frame's order filed under the welded frame's ids (as an entry
+    // keyed on the triangles alone would use it) changes the welded frame's answer, and filed under
+    // the shuffled frame's triangles (as one keyed on the ids alone would) the shuffled frame's.
+    cullide::detail::QuickSelfCache planted;
+    (void)quick_self(base, 4, &planted);
+    REQUIRE(planted.entries.size() == 1);
+    REQUIRE(planted.entries[0].valid);
+    const std::vector<std::uint32_t> welded_ids = cullide::weld_vertices(welded[0]);
+    REQUIRE(welded_ids != planted.entries[0].weld);
+    planted.entries[0].weld = welded_ids;
+    CHECK_FALSE(same_quick(quick_self(welded, 4, &planted), fresh_welded));
+    // And under the shuffled frame's triangles.
+    (void)quick_self(base, 4, &planted);
+    planted.entries[0].triangles = shuffled[0].triangles;
+    CHECK_FALSE(same_quick(quick_self(shuffled, 4, &planted), fresh_shuffled));
 }
 
 TEST_CASE("A FrameContext stays usable after a failed frame and after a move") {

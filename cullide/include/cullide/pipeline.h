@@ -135,11 +135,13 @@ struct FrameResult {
 };
 
 // What process_frame keeps from one frame to the next when the caller holds it: the emulator device
-// with its depth target, and whether small frames run serially. A frame costs milliseconds of
-// set-up without one (a depth target allocated and cleared, worker threads woken) and microseconds
-// with one, which is what fuzzers and per-frame simulation loops need (docs/cullide.md, "Tiny
-// frames"). It holds no answer: a frame's results are the same bits with a fresh context, a reused
-// one, or none, whatever frames of whatever sizes, methods and options ran through it before.
+// with its depth target, and Quick-CULLIDE's self-collision triangle order per object with the
+// topology it came from (used only while the triangles and welded vertices stay the same). A frame
+// costs milliseconds of set-up without one (a depth target allocated and cleared, worker threads
+// woken) and microseconds with one, which is what fuzzers and per-frame simulation loops need
+// (docs/cullide.md, "Tiny frames"). It holds no answer: a frame's results are the same bits with a
+// fresh context, a reused one, or none, whatever frames of whatever sizes, methods and options ran
+// through it before.
 // Movable, not copyable; one frame at a time (not for concurrent calls from several threads).
 class FrameContext {
    public:
