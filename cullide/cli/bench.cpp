@@ -503,8 +503,12 @@ int bench_command(const std::vector<std::string>& args, std::ostream& out, std::
             return 0;
         }
         const BenchArgs a = bench_args_of(command, settings);
-        const FrameRunner process = [](std::span<const Mesh> objects, const RunOptions& o) {
-            return process_frame(objects, o);
+        // One FrameContext for the whole command, as a simulation loop holds one across its frames:
+        // what it keeps (the emulator device, qcullide --self's triangle orders) changes no result
+        // (every repeated run is still checked for the same pairs), only the set-up each frame pays.
+        FrameContext context;
+        const FrameRunner process = [&context](std::span<const Mesh> objects, const RunOptions& o) {
+            return process_frame(objects, o, context);
         };
         return run_bench(a, out, err, runner ? *runner : process);
     } catch (const UsageError& e) {

@@ -30,7 +30,8 @@ namespace cullide::cli {
 using FrameRunner = std::function<Result<FrameResult>(std::span<const Mesh>, const RunOptions&)>;
 
 // `cullide bench ...` / `cullide sweep ...` (args[0] is "bench" or "sweep"). Returns the exit status:
-// 0 success, 1 a check failed or a run failed, 2 bad usage. `runner` null: process_frame.
+// 0 success, 1 a check failed or a run failed, 2 bad usage. `runner` null: process_frame with one
+// FrameContext for the whole command.
 int bench_command(const std::vector<std::string>& args, std::ostream& out, std::ostream& err,
                   const FrameRunner* runner = nullptr);
 

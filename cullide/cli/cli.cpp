@@ -146,11 +146,12 @@ int run_command(const std::vector<std::string>& args, std::ostream& out, std::os
     }
     double total_ms = 0;
     std::uint64_t total_pairs = 0;
+    FrameContext context;  // kept from frame to frame (pipeline.h): the same results, less set-up
     for (int f = 0; f < frames; ++f) {
         Frame frame_objects;
         if (generator) frame_objects = generator->frame(f);
         std::span<const Mesh> objects = generator ? std::span<const Mesh>(frame_objects) : file_objects;
-        Result<FrameResult> fr = process_frame(objects, r.options);
+        Result<FrameResult> fr = process_frame(objects, r.options, context);
         if (!fr) {
             if (r.json) out << "]}\n";
             err << "cullide: error: frame " << f << ": " << fr.error().message << "\n";
