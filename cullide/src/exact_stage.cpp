@@ -15,6 +15,7 @@
 #endif
 
 #include "cullide/tri_tri.h"
+#include "kept.h"
 #include "parallel.h"
 
 namespace cullide::detail {
@@ -774,6 +775,16 @@ void gather(const TriTask& t, const ExactObject& o, const TriangleBoxes& boxes, 
     }
 }
 
+// A ref's cells in sweep_slab: rows [v0, v1] of the slab, columns [u0, u0 + width) of each; `first`
+// is the (cell, side) slot of (u0, v0).
+struct SlabSpan {
+    std::uint32_t first, width, rows;
+};
+struct SlabScratch {
+    std::vector<std::uint32_t> next, begin, idx;
+    std::vector<SlabSpan> spans;
+};
+
 // Bins the refs of slab `s` of task `t` (the first `n0` are side a's) into its cells and sweeps
 // every cell, calling visit(position in a, position in b) for each pair of refs whose float boxes
 // overlap, in the cell owning it.
@@ -785,15 +796,17 @@ void sweep_slab(const TriTask& t, int s, const std::vector<TriRef>& refs, std::s
     while (r1 < t.row_slab.size() && t.row_slab[r1] == slab) ++r1;
     const auto gu = static_cast<std::uint32_t>(t.gu.cells);
     const std::size_t cells = static_cast<std::size_t>(r1 - r0) * gu;
-    std::vector<std::uint32_t> next(2 * cells + 1, 0);  // counts, then fill cursors, of (cell, side)
-    // A ref's cells: rows [v0, v1] of the slab, columns [u0, u0 + width) of each; `first` is the
-    // (cell, side) slot of (u0, v0), 2 * cell + side. Most refs touch one cell: a direct slot for
-    // them (these two passes were 14% of a breaking frame with the double loop and its index
-    // arithmetic for every ref).
-    struct Span {
-        std::uint32_t first, width, rows;
-    };
-    std::vector<Span> spans(refs.size());
+    // Per-thread scratch kept between calls (kept.h: fresh vectors faulted their pages in again
+    // every frame); nothing in a slab job runs another one on this thread.
+    thread_local SlabScratch scratch;
+    std::vector<std::uint32_t>& next = scratch.next;  // counts, then fill cursors, of (cell, side)
+    next.assign(2 * cells + 1, 0);
+    // Each ref's cells (SlabSpan; its slot is 2 * cell + side). Most refs touch one cell: a direct
+    // slot for them (these two passes were 14% of a breaking frame with the double loop and its
+    // index arithmetic for every ref).
+    using Span = SlabSpan;
+    std::vector<Span>& spans = scratch.spans;
+    spans.resize(refs.size());
     const int u = t.gu.axis, v = t.gv.axis;
     for (std::size_t i = 0; i < refs.size(); ++i) {
         const TriRef& r = refs[i];
@@ -812,8 +825,10 @@ void sweep_slab(const TriTask& t, int s, const std::vector<TriRef>& refs, std::s
     };
     for (const Span& sp : spans) for_slots(sp, [&](std::uint32_t slot) { ++next[slot + 1]; });
     for (std::size_t k = 0; k < 2 * cells; ++k) next[k + 1] += next[k];
-    std::vector<std::uint32_t> begin(next.begin(), next.end());  // (cell, side) c: [begin[c], begin[c + 1])
-    std::vector<std::uint32_t> idx(next[2 * cells]);
+    std::vector<std::uint32_t>& begin = scratch.begin;  // (cell, side) c: [begin[c], begin[c + 1])
+    begin.assign(next.begin(), next.end());
+    std::vector<std::uint32_t>& idx = scratch.idx;
+    idx.resize(next[2 * cells]);
     for (std::size_t i = 0; i < refs.size(); ++i)
         for_slots(spans[i], [&](std::uint32_t slot) { idx[next[slot]++] = static_cast<std::uint32_t>(i); });
 
@@ -1265,12 +1280,16 @@ ExactStageResult sweep_exact_triangles(std::span<const ExactObject> objects,
         if (tasks[t].self()) side_b[t] = jobs.size();
     }
     task_jobs[tasks.size()] = jobs.size();
-    std::vector<SlabRefs> gathered(jobs.size());
+    // Kept by the calling thread between calls (kept.h), each list emptied before its job fills it.
+    const Kept<std::vector<SlabRefs>, struct GatheredTag> kept_gathered;
+    std::vector<SlabRefs>& gathered = *kept_gathered;
+    if (gathered.size() < jobs.size()) gathered.resize(jobs.size());
     parallel_chunks(options.threads, jobs.size(), [&](std::size_t j) {
         const GatherJob& g = jobs[j];
         const TriTask& t = tasks[g.task];
         const std::uint32_t o = g.side == 0 ? t.a : t.b;
         gathered[j].resize(static_cast<std::size_t>(t.slabs));
+        for (std::vector<TriRef>& refs : gathered[j]) refs.clear();
         gather(t, objects[o], boxes[o], orders[o], g.first, g.last, in_task[o], gathered[j]);
     });
     struct SlabJob {

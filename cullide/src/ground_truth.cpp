@@ -17,6 +17,7 @@
 
 #include "cullide/predicates.h"
 #include "exact_stage.h"
+#include "kept.h"
 #include "parallel.h"
 
 namespace cullide {
@@ -140,22 +141,25 @@ constexpr std::size_t kScanChunk = 4096;
 
 // An array the scan jobs construct in place: std::vector's resize would first write every element,
 // on one thread (12 MB on bunny-dragon). Only trivially destructible elements, each constructed by a
-// job before anything reads it.
-template <class T>
+// job before anything reads it. Its storage is kept by the calling thread between calls (kept.h:
+// otherwise its pages may be faulted in afresh every frame); Tag names the array.
+template <class T, class Tag>
 class ScanArray {
     static_assert(std::is_trivially_destructible_v<T>);
+    static_assert(alignof(T) <= __STDCPP_DEFAULT_NEW_ALIGNMENT__);
 
    public:
-    explicit ScanArray(std::size_t n) : size_(std::max<std::size_t>(n, 1)), data_(std::allocator<T>().allocate(size_)) {}
-    ~ScanArray() { std::allocator<T>().deallocate(data_, size_); }
-    ScanArray(const ScanArray&) = delete;
-    ScanArray& operator=(const ScanArray&) = delete;
+    explicit ScanArray(std::size_t n)
+        : data_(reinterpret_cast<T*>(kept_->reserve(std::max<std::size_t>(n, 1) * sizeof(T)))) {}
     [[nodiscard]] T* data() const { return data_; }
 
    private:
-    std::size_t size_;
+    detail::Kept<detail::KeptBytes, Tag> kept_;
     T* data_;
 };
+struct TriangleBoxesTag;
+struct FloatBoxesTag;
+struct BlockBoxesTag;
 
 }  // namespace
 
@@ -172,9 +176,9 @@ Result<std::vector<TrianglePair>> exact_pairs(std::span<const Mesh> objects, con
         first_triangle[i + 1] = first_triangle[i] + objects[i].triangles.size();
         first_block[i + 1] = first_block[i] + (objects[i].triangles.size() + detail::kBoxBlock - 1) / detail::kBoxBlock;
     }
-    ScanArray<Aabb> boxes(ok ? first_triangle[n] : 0);
-    ScanArray<detail::FloatBox> floats(ok ? first_triangle[n] : 0);
-    ScanArray<Aabb> blocks(ok ? first_block[n] : 0);
+    ScanArray<Aabb, TriangleBoxesTag> boxes(ok ? first_triangle[n] : 0);
+    ScanArray<detail::FloatBox, FloatBoxesTag> floats(ok ? first_triangle[n] : 0);
+    ScanArray<Aabb, BlockBoxesTag> blocks(ok ? first_block[n] : 0);
     std::vector<detail::ExactObject> exact(n);
     if (ok) {
         std::vector<ScanJob> jobs;

@@ -6,10 +6,12 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <iterator>
 #include <limits>
+#include <thread>
 #include <vector>
 
 #include "cullide/ground_truth.h"
@@ -17,6 +19,8 @@
 #include "cullide/tri_tri.h"
 #include "brute_force_pairs.h"
 #include "exact_stage.h"
+#include "kept.h"
+#include "parallel.h"
 #include "test_rng.h"
 
 using cullide::Mesh;
@@ -526,6 +530,95 @@ TEST_CASE("overlapping_sets' grid gives the brute-force pairs on boxes spread in
         total_pairs += want.size();
     }
     CHECK(total_pairs > 20000);
+}
+
+namespace {
+
+// `objects` soups of `triangles` small triangles each over one box (many overlapping, few pairs).
+std::vector<Mesh> soups(std::uint64_t seed, std::uint32_t objects, std::uint32_t triangles) {
+    test::Rng rng(seed);
+    std::vector<Mesh> scene(objects);
+    for (Mesh& m : scene) {
+        for (std::uint32_t t = 0; t < triangles; ++t) {
+            const Vec3 c{rng.grid(0, 10, 64), rng.grid(0, 10, 64), rng.grid(0, 10, 64)};
+            for (int k = 0; k < 3; ++k)
+                m.positions.push_back(c + Vec3{rng.grid(-0.15, 0.15, 64), rng.grid(-0.15, 0.15, 64), rng.grid(-0.15, 0.15, 64)});
+            m.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
+        }
+    }
+    return scene;
+}
+
+}  // namespace
+
+TEST_CASE("Kept storage: one user per thread and tag, a nested user gets its own, the capacity stays") {
+    struct TagA;
+    struct TagB;
+    using cullide::detail::Kept;
+    std::vector<int>* first = nullptr;
+    {
+        const Kept<std::vector<int>, TagA> a;
+        first = &*a;
+        a->assign(1000, 7);
+        const Kept<std::vector<int>, TagA> nested;  // the same tag while `a` is held: its own
+        CHECK(&*nested != first);
+        CHECK(nested->empty());
+        const Kept<std::vector<int>, TagB> other;  // another tag: its own slot
+        CHECK(&*other != first);
+    }
+    const Kept<std::vector<int>, TagA> again;  // released: the slot again, its capacity kept
+    CHECK(&*again == first);
+    CHECK(again->capacity() >= 1000);
+    std::vector<int>* on_other_thread = nullptr;
+    std::thread([&] {
+        const Kept<std::vector<int>, TagA> t;
+        on_other_thread = &*t;
+    }).join();
+    CHECK(on_other_thread != first);
+
+    cullide::detail::KeptBytes bytes;
+    std::byte* p = bytes.reserve(100);
+    REQUIRE(p != nullptr);
+    CHECK(bytes.reserve(100) == p);  // no growth: the same buffer
+    CHECK(bytes.reserve(10) == p);
+    std::byte* q = bytes.reserve(101);  // grows by at least a quarter
+    REQUIRE(q != nullptr);
+    CHECK(bytes.reserve(125) == q);
+    CHECK(reinterpret_cast<std::uintptr_t>(q) % alignof(std::max_align_t) == 0);
+}
+
+TEST_CASE("exact_pairs called from parallel tasks gives every call its serial answer") {
+    // exact_pairs keeps its largest buffers per calling thread (kept.h): calls running at once on
+    // two threads must each get their own. (A call nested inside another on one thread, which oneTBB
+    // may do while a thread waits, is not forced here; the Kept test above covers that case.)
+    // Scenes of different sizes, so that a shared buffer would be too small or hold another scene's
+    // boxes; the two soups of 12,000 make a pair task big enough to be cut into slabs.
+    std::vector<std::vector<Mesh>> scenes = {soups(5, 2, 12000), soups(6, 3, 2000), random_scene(7, 30, 40, true),
+                                             soups(8, 1, 9000), random_scene(9, 6, 15, false)};
+    std::vector<std::vector<TrianglePair>> serial;
+    std::uint64_t total = 0;
+    for (std::size_t k = 0; k < scenes.size(); ++k) {
+        auto r = cullide::exact_pairs(scenes[k], {k % 2 == 0, 1});
+        REQUIRE(r.ok());
+        serial.push_back(r.value());
+        total += r.value().size();
+    }
+    CHECK(total > 500);
+    constexpr std::size_t kCalls = 20;
+    std::vector<std::vector<TrianglePair>> got(kCalls);
+    std::vector<char> ok(kCalls, 0);
+    cullide::detail::parallel_chunks(2, kCalls, [&](std::size_t c) {
+        const std::size_t k = (c * 3) % scenes.size();
+        auto r = cullide::exact_pairs(scenes[k], {k % 2 == 0, 2});
+        if (!r.ok()) return;
+        ok[c] = 1;
+        got[c] = r.value();
+    });
+    for (std::size_t c = 0; c < kCalls; ++c) {
+        CAPTURE(c);
+        REQUIRE(ok[c] == 1);
+        CHECK(got[c] == serial[(c * 3) % scenes.size()]);
+    }
 }
 
 TEST_CASE("the result is the same for 1, 2, 3 and 8 threads") {
