@@ -4,10 +4,15 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
+#include <cstring>
 #include <memory>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#endif
+#if defined(__GLIBC__)
+#include <malloc.h>
 #endif
 
 #include "cullide_detail.h"
@@ -24,6 +29,16 @@ struct FrameContext::State {
     std::unique_ptr<detail::EmulatorDevice> device;
     detail::QuickSelfCache quick_self;  // used only where the frame's topology equals its entry's
 };
+
+bool retain_freed_memory() {
+#if defined(__GLIBC__)
+    const char* tunables = std::getenv("GLIBC_TUNABLES");
+    if (tunables != nullptr && std::strstr(tunables, "glibc.malloc.") != nullptr) return false;
+    return mallopt(M_MMAP_THRESHOLD, 32 << 20) == 1 && mallopt(M_TRIM_THRESHOLD, 256 << 20) == 1;
+#else
+    return false;
+#endif
+}
 
 FrameContext::FrameContext() : state_(std::make_unique<State>()) {}
 FrameContext::~FrameContext() = default;

@@ -105,6 +105,8 @@ void compare(const std::vector<cullide::TrianglePair>& truth, std::vector<cullid
 }  // namespace
 
 int main(int argc, char** argv) {
+    // As the cullide command does (cullide/pipeline.h); the peers run in this process too.
+    const bool retained = cullide::retain_freed_memory();
     std::vector<std::string> scenes{"cylinders"}, peer_names, methods{"exact", "cullide", "rcullide"};
     std::vector<double> scales{1.0};
     int frames = 3, first = 0, step = 5, reps = 3, threads = 0, resolution = 0;  // 0: each method's default
@@ -187,7 +189,7 @@ int main(int argc, char** argv) {
     }
     std::cout << "peers_bench: " << frames << " frame(s) from " << first << " step " << step << ", " << reps
               << " query rep(s), threads " << threads << ", load " << std::fixed << std::setprecision(2)
-              << load_average() << std::defaultfloat << "\n";
+              << load_average() << std::defaultfloat << ", freed memory retained: " << (retained ? "yes" : "no") << "\n";
     int status = 0;
     for (const std::string& scene : scenes) {
         for (double scale : scales) {

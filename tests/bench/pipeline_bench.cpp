@@ -499,12 +499,15 @@ std::string fmt_scale(double s) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    // As the cullide command does (cullide/pipeline.h); OSMesa runs in this process too.
+    const bool retained = cullide::retain_freed_memory();
     parse_own_flags(argc, argv);
     benchmark::Initialize(&argc, argv);
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
     const Config& c = config();
 
     const char* lp = std::getenv("LP_NUM_THREADS");
+    benchmark::AddCustomContext("retain_freed_memory", retained ? "yes" : "no");
     benchmark::AddCustomContext("llvmpipe_threads",
                                 lp != nullptr ? std::string("LP_NUM_THREADS=") + lp
                                               : "default: one per core (" + std::to_string(std::thread::hardware_concurrency()) + ")");

@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <string>
 #include <utility>
 #include <vector>
@@ -20,6 +22,10 @@
 #include "cullide_detail.h"
 #include "emulator_device.h"
 #include "test_rng.h"
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 namespace {
 
@@ -243,6 +249,31 @@ TEST_CASE("Quick-CULLIDE's self order kept between frames is used only for the t
     (void)quick_self(base, 4, &planted);
     planted.entries[0].triangles = shuffled[0].triangles;
     CHECK_FALSE(same_quick(quick_self(shuffled, 4, &planted), fresh_shuffled));
+}
+
+TEST_CASE("retain_freed_memory keeps a freed block of megabytes in the heap (glibc)") {
+#if defined(__GLIBC__) && __GLIBC_PREREQ(2, 33)
+    const char* tunables = std::getenv("GLIBC_TUNABLES");
+    if (tunables != nullptr && std::strstr(tunables, "glibc.malloc.") != nullptr) {
+        CHECK_FALSE(cullide::retain_freed_memory());  // the user's own settings are left alone
+        return;
+    }
+    REQUIRE(cullide::retain_freed_memory());
+    const struct mallinfo2 before = mallinfo2();
+    struct mallinfo2 during {};
+    {
+        std::vector<char> block(std::size_t{8} << 20, 1);  // 8 MB: below the 32 MB mmap threshold
+        during = mallinfo2();
+        CHECK(block[12345] == 1);
+    }
+    const struct mallinfo2 after = mallinfo2();
+    CHECK(during.hblkhd == before.hblkhd);  // from the heap, not a mapping of its own
+    CHECK(during.arena >= before.arena);
+    CHECK(after.arena == during.arena);     // freed, and the heap kept it (trim threshold 256 MB)
+    CHECK(after.fordblks >= (std::size_t{8} << 20));
+#else
+    CHECK_FALSE(cullide::retain_freed_memory());
+#endif
 }
 
 TEST_CASE("A FrameContext stays usable after a failed frame and after a move") {

@@ -159,6 +159,19 @@ class FrameContext {
     std::unique_ptr<State> state_;
 };
 
+// For a process that runs frames in a loop, on glibc: keeps freed memory in the process instead of
+// handing it back to the kernel between frames. A frame allocates and frees buffers of megabytes;
+// with glibc's defaults the pages of some of them are returned when freed (the heap's top beyond its
+// trim threshold, or blocks above its mmap threshold) and faulted in and zeroed again by the next
+// frame, in some runs and not in others, depending on what the process freed before (up to 1.3x a
+// frame's time: docs/cullide.md, "Freed memory between frames"). This sets glibc's mmap threshold to
+// 32 MB (the most its own adjustment reaches) and its trim threshold to 256 MB. The process's peak
+// memory does not grow: what is kept was in use before. Process-wide, so the library never calls it
+// on its own; the `cullide` command and the benchmarks do. Returns whether the settings were made:
+// false on other C libraries, and when GLIBC_TUNABLES names a glibc.malloc setting (the user's own
+// choice is left alone).
+bool retain_freed_memory();
+
 // Runs one frame. Fails on invalid meshes or options, naming what is wrong (the context keeps its
 // buffers and stays usable). The first form uses a temporary FrameContext.
 [[nodiscard]] Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOptions& options);
