@@ -5,7 +5,7 @@
 // give their pages back to the kernel in between (when the free space at the top of its heap passes
 // its trim threshold, which depends on what else was freed before), and then every page is faulted
 // in and zeroed again: about 600 faults a call on the folded cloth's `exact --self`, in some runs
-// and not in others, 1.3x the frame's time. Kept storage keeps its pages: each thread holds at most
+// and not in others, 1.2x the frame's time. Kept storage keeps its pages: each thread holds at most
 // the largest buffer it needed, for the thread's lifetime.
 //
 // One user at a time per thread and tag. A oneTBB thread that waits inside a parallel loop may take

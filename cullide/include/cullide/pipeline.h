@@ -163,7 +163,7 @@ class FrameContext {
 // handing it back to the kernel between frames. A frame allocates and frees buffers of megabytes;
 // with glibc's defaults the pages of some of them are returned when freed (the heap's top beyond its
 // trim threshold, or blocks above its mmap threshold) and faulted in and zeroed again by the next
-// frame, in some runs and not in others, depending on what the process freed before (up to 1.3x a
+// frame, in some runs and not in others, depending on what the process freed before (up to 1.2x a
 // frame's time: docs/cullide.md, "Freed memory between frames"). This sets glibc's mmap threshold to
 // 32 MB (the most its own adjustment reaches) and its trim threshold to 256 MB. The process's peak
 // memory does not grow: what is kept was in use before. Process-wide, so the library never calls it
