@@ -168,8 +168,8 @@ class FrameContext {
 // 32 MB (the most its own adjustment reaches) and its trim threshold to 256 MB. The process's peak
 // memory does not grow: what is kept was in use before. Process-wide, so the library never calls it
 // on its own; the `cullide` command and the benchmarks do. Returns whether the settings were made:
-// false on other C libraries, and when GLIBC_TUNABLES names a glibc.malloc setting (the user's own
-// choice is left alone).
+// false on other C libraries, under an allocator that refuses them (a sanitizer's), and when
+// GLIBC_TUNABLES names a glibc.malloc setting (the user's own choice is left alone).
 bool retain_freed_memory();
 
 // Runs one frame. Fails on invalid meshes or options, naming what is wrong (the context keeps its
