@@ -880,6 +880,47 @@ Result<std::size_t> WindowedPasses::prepare(int width, int height, DepthFormat f
     const auto n_chunks = static_cast<std::size_t>(n_chunks64);
     if (s.chunks.size() < n_chunks) s.chunks.resize(n_chunks);
     const detail::FrontEndParams params = front_end_params(width, height);
+    // Whether triangles [a, b) of m pass the input checks (indices in range, valid vertices).
+    const auto valid_triangles = [](const MeshViewD& m, std::uint64_t a, std::uint64_t b) {
+        const std::size_t nv = m.vertices.size();
+        for (std::uint64_t tri = a; tri < b; ++tri) {
+            const std::size_t k = static_cast<std::size_t>(tri) * 3;
+            const std::uint32_t ia = m.indices[k], ib = m.indices[k + 1], ic = m.indices[k + 2];
+            if (ia >= nv || ib >= nv || ic >= nv || !valid_vertex(m.vertices[ia]) || !valid_vertex(m.vertices[ib]) ||
+                !valid_vertex(m.vertices[ic]))
+                return false;
+        }
+        return true;
+    };
+    // Folds triangle t's pixels into the chunk's records of item `tag` (the smallest zmin and the
+    // largest zmax per pixel).
+    const auto record_pixels = [&](State::Chunk& ch, const detail::BoundsTri& t, std::uint32_t tag)
+        __attribute__((always_inline)) {
+        const double mz = t.margin_z;
+        double last_lo = std::numeric_limits<double>::quiet_NaN(), last_hi = last_lo;
+        std::uint32_t zmin = 0, zmax = 0;  // quantized once per distinct depth
+        detail::bounds_pixels(t, ch.pool.data(), detail::PixelRect{t.x0, t.y0, t.x1, t.y1},
+                              [&](int px, int py, double zlo, double zhi) {
+                                  if (!(zlo == last_lo)) {
+                                      last_lo = zlo;
+                                      zmin = detail::quantize_down(zlo - mz, format);
+                                  }
+                                  if (!(zhi == last_hi)) {
+                                      last_hi = zhi;
+                                      zmax = detail::quantize_up(zhi + mz, format);
+                                  }
+                                  const auto p = static_cast<std::uint32_t>(py * width + px);
+                                  if (ch.stamp[p] != tag) {
+                                      ch.stamp[p] = tag;
+                                      ch.slot[p] = static_cast<std::uint32_t>(ch.records.size());
+                                      ch.records.push_back({p, zmin, zmax});
+                                  } else {
+                                      PixelRecord& r = ch.records[ch.slot[p]];
+                                      r.zmin = std::min(r.zmin, zmin);
+                                      r.zmax = std::max(r.zmax, zmax);
+                                  }
+                              });
+    };
     detail::parallel_for(threads, n_chunks, [&](std::size_t c) {
         State::Chunk& ch = s.chunks[c];
         ch.records.clear();
@@ -905,20 +946,12 @@ Result<std::size_t> WindowedPasses::prepare(int width, int height, DepthFormat f
             if (k0 >= k1) continue;
             const auto begin = static_cast<std::uint32_t>(ch.records.size());
             const auto tag = static_cast<std::uint32_t>(i + 1);
-            const std::size_t nv = m.vertices.size();
             // Runs of up to kSetupRun triangles: checked, set up together (setup_bounds_range: four
             // at a time with AVX2), then drawn in order, one record per triangle that has a pixel.
             constexpr std::uint64_t kSetupRun = 64;
-            bool failed = false;
-            for (std::uint64_t run = k0; run < k1 && !failed; run += kSetupRun) {
+            for (std::uint64_t run = k0; run < k1; run += kSetupRun) {
                 const std::uint64_t run_end = std::min(k1, run + kSetupRun);
-                for (std::uint64_t tri = run; tri < run_end && !failed; ++tri) {
-                    const std::size_t k = static_cast<std::size_t>(tri) * 3;
-                    const std::uint32_t ia = m.indices[k], ib = m.indices[k + 1], ic = m.indices[k + 2];
-                    failed = ia >= nv || ib >= nv || ic >= nv || !valid_vertex(m.vertices[ia]) ||
-                             !valid_vertex(m.vertices[ib]) || !valid_vertex(m.vertices[ic]);
-                }
-                if (failed) {
+                if (!valid_triangles(m, run, run_end)) {
                     s.bad[i] = 1;  // (only ever set to 1: chunks sharing an item agree)
                     break;
                 }
@@ -928,32 +961,7 @@ Result<std::size_t> WindowedPasses::prepare(int width, int height, DepthFormat f
                                            m.indices.subspan(static_cast<std::size_t>(run) * 3,
                                                              static_cast<std::size_t>(run_end - run) * 3),
                                            static_cast<std::uint32_t>(i), ch.tris, ch.pool);
-                for (const detail::BoundsTri& t : ch.tris) {
-                    const double mz = t.margin_z;
-                    double last_lo = std::numeric_limits<double>::quiet_NaN(), last_hi = last_lo;
-                    std::uint32_t zmin = 0, zmax = 0;  // quantized once per distinct depth
-                    detail::bounds_pixels(t, ch.pool.data(), detail::PixelRect{t.x0, t.y0, t.x1, t.y1},
-                                          [&](int px, int py, double zlo, double zhi) {
-                                              if (!(zlo == last_lo)) {
-                                                  last_lo = zlo;
-                                                  zmin = detail::quantize_down(zlo - mz, format);
-                                              }
-                                              if (!(zhi == last_hi)) {
-                                                  last_hi = zhi;
-                                                  zmax = detail::quantize_up(zhi + mz, format);
-                                              }
-                                              const auto p = static_cast<std::uint32_t>(py * width + px);
-                                              if (ch.stamp[p] != tag) {
-                                                  ch.stamp[p] = tag;
-                                                  ch.slot[p] = static_cast<std::uint32_t>(ch.records.size());
-                                                  ch.records.push_back({p, zmin, zmax});
-                                              } else {
-                                                  PixelRecord& r = ch.records[ch.slot[p]];
-                                                  r.zmin = std::min(r.zmin, zmin);
-                                                  r.zmax = std::max(r.zmax, zmax);
-                                              }
-                                          });
-                }
+                for (const detail::BoundsTri& t : ch.tris) record_pixels(ch, t, tag);
             }
             ch.segments.push_back({static_cast<std::uint32_t>(i), begin, static_cast<std::uint32_t>(ch.records.size())});
         }
