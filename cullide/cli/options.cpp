@@ -158,7 +158,7 @@ void add_shared_options(std::vector<OptionSpec>& t) {
          "",
          kAllCommands,
          "also report pairs inside one object (adjacent triangles excluded); methods exact, qcullide, "
-         "qcullide-gl (run: qcullide unless --method is given)",
+         "qcullide-gl, auto (which runs exact then)",
          {},
          "",
          "",
