@@ -633,7 +633,8 @@ Result<std::vector<TrianglePair>> detail::cullide_pairs(std::span<const Mesh> ob
 
     auto t0 = Clock::now();
     std::vector<ObjectGeometry> boxes = box_geometry(objects, active, options.threads);
-    if (Status s = run_stage(boxes, CullStage::Boxes, options, size, device, st); !s) return s.error();
+    if (options.box_stage)
+        if (Status s = run_stage(boxes, CullStage::Boxes, options, size, device, st); !s) return s.error();
     st.pcs_boxes = count_live(boxes);
     st.boxes_ms = ms_since(t0);
 

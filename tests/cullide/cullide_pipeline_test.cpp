@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -230,6 +231,126 @@ TEST_CASE("the broad phase keeps the ground truth and drops objects that overlap
             CHECK(r.stats.broadphase_pairs == 3);
         }
     }
+}
+
+namespace {
+
+// The objects whose closed box (over their triangles' vertices) overlaps another object's: what a
+// broad phase keeps, found here by brute force.
+std::vector<std::uint32_t> overlapping_objects(const cullide::Frame& objects) {
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    std::vector<cullide::Aabb> box(objects.size(), cullide::Aabb{{inf, inf, inf}, {-inf, -inf, -inf}});
+    for (std::size_t i = 0; i < objects.size(); ++i)
+        for (const cullide::Tri& t : objects[i].triangles)
+            for (std::uint32_t v : t) {
+                const cullide::Vec3& p = objects[i].positions[v];
+                box[i].lo = {std::min(box[i].lo.x, p.x), std::min(box[i].lo.y, p.y), std::min(box[i].lo.z, p.z)};
+                box[i].hi = {std::max(box[i].hi.x, p.x), std::max(box[i].hi.y, p.y), std::max(box[i].hi.z, p.z)};
+            }
+    std::vector<std::uint32_t> kept;
+    for (std::size_t i = 0; i < objects.size(); ++i)
+        for (std::size_t j = 0; j < objects.size(); ++j)
+            if (i != j && box[i].lo.x <= box[j].hi.x && box[j].lo.x <= box[i].hi.x && box[i].lo.y <= box[j].hi.y &&
+                box[j].lo.y <= box[i].hi.y && box[i].lo.z <= box[j].hi.z && box[j].lo.z <= box[i].hi.z) {
+                kept.push_back(static_cast<std::uint32_t>(i));
+                break;
+            }
+    return kept;
+}
+
+std::size_t box_views(const cullide::VisibilityStats& s) {
+    return static_cast<std::size_t>(std::count_if(s.views.begin(), s.views.end(),
+                                                  [](const cullide::ViewStats& v) { return v.stage == cullide::CullStage::Boxes; }));
+}
+
+}  // namespace
+
+TEST_CASE("after a broad phase rcullide skips its box views, which would prune nothing: the same PCS and pairs") {
+    auto device = cullide::make_emulator_device(2);
+    REQUIRE(device);
+    std::size_t frames_with_dropped = 0;
+    for (const char* name : {"cylinders", "leaves", "breaking", "tori", "cloth"}) {
+        cullide::SceneOptions so;
+        so.scale = 0.3;
+        auto scene = cullide::make_scene(name, so);
+        REQUIRE(scene.ok());
+        for (int f : {0, 17, 40}) {
+            CAPTURE(name);
+            CAPTURE(f);
+            const cullide::Frame objects = scene.value()->frame(f);
+            const cullide::FrameResult skipped = run(objects, Method::RCullide, 32, 2, cullide::BroadPhase::SweepAndPrune);
+            const std::vector<std::uint32_t> active = overlapping_objects(objects);
+            REQUIRE(skipped.stats.broadphase_objects == active.size());
+            if (active.size() < objects.size()) ++frames_with_dropped;
+            CHECK(box_views(skipped.stats) == 0);
+            if (active.size() < 2) continue;
+            // The same objects with the box views run: they prune none of them, and everything after
+            // them is the same.
+            cullide::CullideOptions co;
+            co.mode = cullide::VisibilityMode::ExactBounds;
+            co.resolution = 32;
+            co.threads = 2;
+            REQUIRE(co.box_stage);
+            cullide::CullideStats with;
+            auto pairs = cullide::cullide_pairs(objects, active, co, *device, &with);
+            REQUIRE_MESSAGE(pairs.ok(), pairs.error().message);
+            CHECK(box_views(with) > 0);
+            CHECK(with.pcs_boxes == active.size());
+            CHECK(pairs.value() == skipped.pairs);
+            CHECK(with.pcs_objects == skipped.stats.pcs_objects);
+            CHECK(with.subobjects == skipped.stats.subobjects);
+            CHECK(with.pcs_subobjects == skipped.stats.pcs_subobjects);
+            CHECK(with.subobject_pairs == skipped.stats.subobject_pairs);
+            CHECK(with.candidate_triangles == skipped.stats.candidate_triangles);
+            CHECK(with.exact_tests == skipped.stats.exact_tests);
+            // The sub-object views, one for one.
+            std::vector<cullide::ViewStats> later;
+            for (const cullide::ViewStats& v : with.views)
+                if (v.stage != cullide::CullStage::Boxes) later.push_back(v);
+            REQUIRE(later.size() == skipped.stats.views.size());
+            for (std::size_t v = 0; v < later.size(); ++v) {
+                CHECK(later[v].items_before == skipped.stats.views[v].items_before);
+                CHECK(later[v].items_after == skipped.stats.views[v].items_after);
+                CHECK(later[v].queries == skipped.stats.views[v].queries);
+            }
+        }
+    }
+    CHECK(frames_with_dropped > 0);  // the broad phase dropped objects somewhere, so the check above had room to differ
+    // CULLIDE (GL-exact) keeps its box views after a broad phase: they may prune overlapping boxes.
+    cullide::SceneOptions so;
+    so.scale = 0.3;
+    auto scene = cullide::make_scene("cylinders", so);
+    REQUIRE(scene.ok());
+    const cullide::Frame objects = scene.value()->frame(0);
+    CHECK(box_views(run(objects, Method::Cullide, 256, 2, cullide::BroadPhase::SweepAndPrune).stats) > 0);
+    CHECK(box_views(run(objects, Method::RCullide, 32, 2).stats) > 0);  // and rcullide without a broad phase
+}
+
+TEST_CASE("rcullide without its box stage still reports exactly the ground truth (the stage only prunes)") {
+    auto device = cullide::make_emulator_device(2);
+    REQUIRE(device);
+    cullide::SceneOptions so;
+    so.scale = 0.3;
+    auto scene = cullide::make_scene("cylinders", so);
+    REQUIRE(scene.ok());
+    const cullide::Frame objects = scene.value()->frame(5);
+    std::vector<std::uint32_t> all(objects.size());
+    for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::uint32_t>(i);
+    cullide::CullideOptions co;
+    co.mode = cullide::VisibilityMode::ExactBounds;
+    co.resolution = 32;
+    co.threads = 2;
+    cullide::CullideStats on, off;
+    auto with = cullide::cullide_pairs(objects, all, co, *device, &on);
+    co.box_stage = false;
+    auto without = cullide::cullide_pairs(objects, all, co, *device, &off);
+    REQUIRE(with.ok());
+    REQUIRE(without.ok());
+    CHECK(with.value() == truth(objects));
+    CHECK(without.value() == with.value());
+    CHECK(on.pcs_boxes < objects.size());  // here the box views prune: skipping them is a real change
+    CHECK(off.pcs_boxes == objects.size());
+    CHECK(box_views(off) == 0);
 }
 
 TEST_CASE("bad options and inputs are errors that name the problem") {

@@ -78,6 +78,14 @@ struct CullideOptions : VisibilityOptions {
     // triangles of the two recorded passes it replaces. false records and executes the passes
     // (QueryDevice::recorded_visibility_pass; tests compare the two).
     bool fused_visibility = true;
+    // Stage 1, views of each object's box (12 triangles), runs when true. With ExactBounds its views
+    // can prune only objects whose closed box overlaps no other active object's box: where two boxes
+    // overlap, each pass finds one of the two behind (or level with) the other at a pixel both cover,
+    // so neither is fully visible in both (docs/cullide.md, "The box stage after a broad phase").
+    // A broad phase leaves exactly the objects that overlap another, so after one the stage prunes
+    // nothing and process_frame turns it off for rcullide. false is always safe (the stage only
+    // prunes): the later stages then start from every active object.
+    bool box_stage = true;
 };
 
 // The shared figures (visibility.h: pcs_boxes, pcs_objects, pcs_subobjects are the PCS after each
