@@ -86,11 +86,14 @@ const char* name_of(E e, const std::pair<const char*, E> (&table)[N]) {
     return "?";
 }
 
-// Objects whose box overlaps another object's box (all objects for BroadPhase::None).
+// Whether the broad phase drops objects: one is chosen, and self-collision is off (with it a lone
+// object can still collide with itself).
+bool broad_phase_drops(const RunOptions& o) { return o.broadphase != BroadPhase::None && !o.self; }
+
+// Objects whose box overlaps another object's box (all objects when !broad_phase_drops).
 Result<std::vector<std::uint32_t>> broad_phase(std::span<const Mesh> objects, const RunOptions& o, FrameStats& st) {
     std::vector<std::uint32_t> active;
-    if (o.broadphase == BroadPhase::None || o.self) {
-        // With self-collision a lone object can still collide with itself: nothing is dropped.
+    if (!broad_phase_drops(o)) {
         for (std::size_t i = 0; i < objects.size(); ++i) active.push_back(static_cast<std::uint32_t>(i));
         return active;
     }
@@ -187,7 +190,7 @@ Status run_visibility(std::span<const Mesh> objects, const std::vector<std::uint
         // 0.6 ms of a 4.3 ms cylinders frame at 1 thread and prune nothing. GL-exact CULLIDE keeps
         // them (its views may prune overlapping boxes: that is how it misses), as does the offset
         // method (not argued here).
-        co.box_stage = !(co.mode == VisibilityMode::ExactBounds && o.broadphase != BroadPhase::None && !o.self);
+        co.box_stage = !(co.mode == VisibilityMode::ExactBounds && broad_phase_drops(o));
         CullideStats cs;
         pairs = detail::cullide_pairs(objects, active, co, *device, &cs, true);  // checked by process_frame
         static_cast<VisibilityStats&>(st) = std::move(cs);
@@ -381,7 +384,7 @@ Result<FrameResult> process_frame(std::span<const Mesh> objects, const RunOption
     // checked there, in its parallel box scan, with the same messages and the same first problem
     // named; the serial checks cost 3-10% of such a frame. Nothing before exact_pairs on that route
     // reads a triangle's indices (plan_auto reads the positions only).
-    const bool all_objects = options.broadphase == BroadPhase::None || options.self;
+    const bool all_objects = !broad_phase_drops(options);
     const bool checked_later =
         all_objects && (options.method == Method::Exact || options.method == Method::Auto);
     // The frame's triangles, and its worker count: frames of at most kSerialFrameTriangles
