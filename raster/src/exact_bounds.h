@@ -303,6 +303,142 @@ BoundsReach bounds_reach(const FrontEndParams& params, const MeshViewD& mesh, De
     return r;
 }
 
+// Cheap bounds of the outward quantizations, for the settling pre-pass (a looser bound settles
+// fewer items, never a wrong one). Let c(z) be fl(z' * n) truncated (D16, D24) or the bits of
+// float(z') rounded to nearest (D32F), z' = z clamped to [0, 1] as both quantizations clamp. Both
+// are monotone, and c(z) >= quantize_down(z) (floor(z' n) is representable and rounding is
+// monotone; round to nearest gives the float below or the one above) and c(z) <= quantize_up(z)
+// (likewise). So c(z) bounds quantize_down from above and quantize_up from below, and c(z) - 1 and
+// c(z) + 1 (kept inside the encodings) bound quantize_down from below and quantize_up from above
+// (c is at most one step from either).
+inline std::uint32_t encode_near(double z, DepthFormat format) {
+    z = z > 0.0 ? z : 0.0;
+    z = z < 1.0 ? z : 1.0;
+    if (format == DepthFormat::D32F) return std::bit_cast<std::uint32_t>(static_cast<float>(z));
+    const double n = format == DepthFormat::D16 ? 65535.0 : 16777215.0;
+    return static_cast<std::uint32_t>(static_cast<std::int64_t>(z * n));
+}
+inline std::uint32_t encode_below_down(double z, DepthFormat format) {
+    const std::uint32_t c = encode_near(z, format);
+    return c > 0 ? c - 1 : 0;
+}
+inline std::uint32_t encode_above_up(double z, DepthFormat format) {
+    const std::uint32_t c = encode_near(z, format);
+    const std::uint32_t top = format == DepthFormat::D32F ? 0x3f800000u : format == DepthFormat::D16 ? 65535u : 16777215u;
+    return c < top ? c + 1 : top;
+}
+
+// The bounds of a list of triangles from their vertices alone, without setting them up: for the
+// fused visibility pass's settling pre-pass (visibility.cpp, State::presettle). It calls
+// box(x0, y0, x1, y1, lo, hi) (inclusive pixels inside the target) for boxes such that every
+// BoundsTri record that setup_bounds_triangle makes of the triangles (indices[3k], indices[3k + 1],
+// indices[3k + 2]) of `mesh` lies in one of them with the encoded zmin of each of its fragments
+// >= lo and its zmax <= hi (the draw's quantization is quantize_down(zlo - margin_z) and
+// quantize_up(zhi + margin_z); lo and hi are the cheap bounds of those, encode_below_down and
+// encode_above_up): the list's box, or, when that is more than kReachSpread pixels per triangle
+// (scattered triangles), one box per triangle with its own depth bounds. With `inside` (every
+// |coordinate| <= 1) no triangle is clipped (WindowMap below gives its window vertices).
+// Why: with every |coordinate| <= 1 < lim setup takes the unclipped path with M = 1, so each
+// triangle's margins are kPixelMargin + kClipMarginRel * max(w / 2, h / 2) and kDepthMargin +
+// kClipMarginRel, and its box is grown_box of its window extremes. The window map x * (w / 2) +
+// (x0 + w / 2) is monotone in x (so is its rounding), so the extremes of more vertices map to
+// extremes at least as far out, and grown_box is monotone too. Every (zlo, zhi) a path reports lies
+// in the triangle's vertex depth range widened by 2^-40 max|z| + 2^-1000 (bounds_depth_range, which
+// widens only the general path; the others stay inside the vertex range), and subtraction, addition
+// and both quantizations are monotone. A list with a larger coordinate may be clipped: bounds_reach's
+// boxes (pixels; they hold every record's box) with the widest encoded range. ok = false when an index or
+// vertex fails the input checks (the front end reports it; box may have been called).
+struct ListBounds {
+    bool ok = true;
+    bool inside = false;
+};
+template <class Box>
+inline ListBounds list_bounds(const FrontEndParams& params, const MeshViewD& mesh, DepthFormat format, Box&& box) {
+    ListBounds r;
+    const std::size_t nv = mesh.vertices.size();
+    const std::size_t n = mesh.indices.size() - mesh.indices.size() % 3;
+    if (n == 0) return r;
+    constexpr double kInf = __builtin_inf();
+    double absmax = 0.0, cx0 = kInf, cx1 = -kInf, cy0 = kInf, cy1 = -kInf, cz0 = kInf, cz1 = -kInf;
+    for (std::size_t k = 0; k < n; ++k) {
+        const std::uint32_t i = mesh.indices[k];
+        if (i >= nv) {
+            r.ok = false;
+            return r;
+        }
+        const Double4& v = mesh.vertices[i];
+        const double m = std::max(std::max(std::fabs(v.x), std::fabs(v.y)), std::fabs(v.z));
+        if (v.w != 1.0 || !(m <= kMaxExactBoundsCoordinate)) {
+            r.ok = false;
+            return r;
+        }
+        absmax = m > absmax ? m : absmax;
+        cx0 = std::min(cx0, v.x), cx1 = std::max(cx1, v.x);
+        cy0 = std::min(cy0, v.y), cy1 = std::max(cy1, v.y);
+        cz0 = std::min(cz0, v.z), cz1 = std::max(cz1, v.z);
+    }
+    if (!(absmax <= 1.0)) {  // may be clipped: bounds_reach's boxes, with the widest depth range
+        (void)bounds_reach(params, mesh, format, 0,
+                           [&](int x0, int y0, int x1, int y1) { box(x0, y0, x1, y1, 0u, 0xffffffffu); });
+        return r;
+    }
+    const Viewport& vp = params.viewport;
+    const double hw = static_cast<double>(vp.width) * 0.5;
+    const double hh = static_cast<double>(vp.height) * 0.5;
+    const double tx = static_cast<double>(vp.x) + hw;
+    const double ty = static_cast<double>(vp.y) + hh;
+    r.inside = true;
+    const double mc = kClipMarginRel;  // M = 1
+    const double m = kPixelMargin + mc * std::max(hw, hh);
+    const double mz = kDepthMargin + mc;
+    // The box of window extremes [x0, x1] x [y0, y1] and depths [z0, z1], cut to the target.
+    const auto emit = [&](double x0, double x1, double y0, double y1, double z0, double z1, bool spread_check) {
+        const GrownBox g = grown_box(x0, x1, y0, y1, m);
+        if (g.outside(params.target_width, params.target_height)) return true;  // no fragment
+        int b[4];
+        g.cut(params.target_width, params.target_height, b[0], b[1], b[2], b[3]);
+        if (spread_check && n > 3 &&
+            static_cast<std::size_t>(b[2] - b[0] + 1) * static_cast<std::size_t>(b[3] - b[1] + 1) >
+                static_cast<std::size_t>(kReachSpread) * (n / 3))
+            return false;
+        const double slack = 0x1p-40 * std::max(std::fabs(z0), std::fabs(z1)) + 0x1p-1000;
+        box(b[0], b[1], b[2], b[3], encode_below_down((z0 - slack) - mz, format),
+            encode_above_up((z1 + slack) + mz, format));
+        return true;
+    };
+    if (!emit(cx0 * hw + tx, cx1 * hw + tx, cy0 * hh + ty, cy1 * hh + ty, cz0 * 0.5 + 0.5, cz1 * 0.5 + 0.5, true)) {
+        for (std::size_t k = 0; k < n; k += 3) {  // scattered: a box per triangle
+            const Double4& a = mesh.vertices[mesh.indices[k]];
+            const Double4& b = mesh.vertices[mesh.indices[k + 1]];
+            const Double4& c = mesh.vertices[mesh.indices[k + 2]];
+            emit(std::min(std::min(a.x, b.x), c.x) * hw + tx, std::max(std::max(a.x, b.x), c.x) * hw + tx,
+                 std::min(std::min(a.y, b.y), c.y) * hh + ty, std::max(std::max(a.y, b.y), c.y) * hh + ty,
+                 std::min(std::min(a.z, b.z), c.z) * 0.5 + 0.5, std::max(std::max(a.z, b.z), c.z) * 0.5 + 0.5, false);
+        }
+    }
+    return r;
+}
+
+// The window position of a vertex of a list that list_bounds found `inside`: the very values that
+// setup_bounds_triangle's unclipped path computes for it (the same operations on the same inputs).
+struct WindowMap {
+    double hw, hh, tx, ty;
+    explicit WindowMap(const FrontEndParams& params)
+        : hw(static_cast<double>(params.viewport.width) * 0.5),
+          hh(static_cast<double>(params.viewport.height) * 0.5),
+          tx(static_cast<double>(params.viewport.x) + hw),
+          ty(static_cast<double>(params.viewport.y) + hh) {}
+    [[nodiscard]] BoundsVertex operator()(const Double4& v) const { return {v.x * hw + tx, v.y * hh + ty, v.z * 0.5 + 0.5}; }
+};
+
+// How far a reported depth range may lie from a window vertex's depth z inside the pixel: every
+// (zlo, zhi) reported for a pixel whose square holds a window vertex of an unclipped triangle has
+// zlo <= z + kVertexSlack and zhi >= z - kVertexSlack. The paths are conservative (each range holds
+// the polygon's depths over the grown square, up to roundings below 2^-40 of the depth range, far
+// smaller than this), and the vertex's own pixel is always reported (its square holds a point of
+// the polygon). Used only to settle answers early, so a larger slack loses speed, never an answer.
+inline constexpr double kVertexSlack = 0x1p-30;
+
 // ---- the per-pixel traversal shared by bounds_rect and the fused visibility pass ----
 
 struct BoundsP3 {

@@ -59,13 +59,24 @@ constexpr std::uint64_t kSplitRunsPerThread = 4;
 // power of two: a method's stages call with their own shapes, frame after frame) keeps the share
 // of triangles its last pre-pass spared; a call runs the pre-pass when its shape has none yet or
 // spared at least kAloneMinSpared, and otherwise after 2, 4, ... up to kAloneProbe calls without it
-// (doubling after each run that did not pay), to notice when the scene changes (a probe every 8th
-// call cost those scenes 1-6%, every 32nd under 1%). Calls of fewer than kAloneMinTriangles
+// (doubling after each run that did not pay, quadrupling after one that spared under half the bar),
+// to notice when the scene changes (a probe every 8th call cost those scenes 1-6%, every 32nd
+// under 1%). The settling pre-pass keeps such a history too (kSettleMinSpared). Calls of fewer than kAloneMinTriangles
 // triangles always run it (cheap either way). Only the work depends on it, never an answer.
 constexpr std::uint64_t kAloneMinTriangles = 1024;
 constexpr double kAloneMinSpared = 0.3;
 constexpr unsigned kAloneProbe = 32;
 constexpr std::size_t kAloneShapes = 64;
+// The settling pre-pass (State::presettle) runs on one-tile targets; its per-item verdicts. Its
+// phases run in parts of at least kPresettlePartIndices indices (about 100 us of work each: below
+// that, the five parallel regions cost more than they save).
+constexpr std::uint8_t kOpen = 0, kNotHit = 1, kHit = 2;
+constexpr std::size_t kPresettlePartIndices = 4096;
+// The settling pre-pass pays where it leaves out at least this share of a call's triangles (it
+// costs about a third of a triangle's setup and drawing per triangle, more on large meshes whose
+// vertices miss the cache); its history per shape of call is kept as the alone pre-pass's.
+constexpr double kSettleMinSpared = 0.75;
+constexpr std::size_t kPrefetchVertices = std::size_t{1} << 15;  // 1 MB of Double4
 
 
 std::string check_vertex(const Double4& d) {
@@ -163,6 +174,19 @@ void occ_mark(const detail::CellGrid& g, std::uint32_t* key, std::uint8_t* state
     }
 }
 
+// Merges cells of occ_mark (obj / state) b into a: kOccMany where they hold different objects.
+void merge_occ(std::uint32_t* ao, std::uint8_t* as, const std::uint32_t* bo, const std::uint8_t* bs,
+               std::size_t cells) {
+    for (std::size_t c = 0; c < cells; ++c) {
+        if (bs[c] == kOccNone) continue;
+        if (as[c] == kOccNone) {
+            as[c] = bs[c];
+            ao[c] = bo[c];
+        } else if (bs[c] == kOccMany || ao[c] != bo[c]) {
+            as[c] = kOccMany;
+        }
+    }
+}
 // Whether every cell of the pixel box is reached by one object only.
 inline bool occ_one(const detail::CellGrid& g, const std::uint8_t* state, int x0, int y0, int x1, int y1) {
     for (int cy = y0 >> g.shift; cy <= y1 >> g.shift; ++cy) {
@@ -182,31 +206,94 @@ inline bool occ_alone(const detail::CellGrid& g, const std::uint8_t* state, cons
     return r.single && r.zq_hi < clear && occ_one(g, state, r.x0, r.y0, r.x1, r.y1);
 }
 
-// When the items-alone pre-pass runs (kAloneMinSpared, kAloneProbe above): per shape of call, the
-// share its last pre-pass spared (negative: none yet) and the calls since.
-struct AloneGuard {
+// The per-pixel record the pass keeps (see test_fragments): m1 the smallest value with its object o1,
+// m2 the smallest value of any object other than o1 (each starts at the clear value).
+inline void min_by_object(std::uint32_t* m1, std::uint32_t* o1, std::uint32_t* m2, std::size_t p, std::uint32_t obj,
+                          std::uint32_t z) {
+    if (obj == o1[p]) {
+        m1[p] = std::min(m1[p], z);
+    } else if (z < m1[p]) {
+        m2[p] = m1[p];
+        m1[p] = z;
+        o1[p] = obj;
+    } else {
+        m2[p] = std::min(m2[p], z);
+    }
+}
+// The smallest value at pixel p over the objects other than obj (with the clear value).
+inline std::uint32_t other_min(const std::uint32_t* m1, const std::uint32_t* o1, const std::uint32_t* m2, std::size_t p,
+                               std::uint32_t obj) {
+    return o1[p] == obj ? m2[p] : m1[p];
+}
+// Merges record b into record a, pixel by pixel: a then holds the record of both sets of values (the
+// smaller m1 wins with its object; m2 becomes the minimum over the objects other than that one,
+// which from the other record is its m2 if it holds the same object and its m1 otherwise).
+void merge_min_by_object(std::uint32_t* a1, std::uint32_t* ao, std::uint32_t* a2, const std::uint32_t* b1,
+                         const std::uint32_t* bo, const std::uint32_t* b2, std::size_t pixels) {
+    for (std::size_t p = 0; p < pixels; ++p) {
+        if (b1[p] < a1[p]) {
+            a2[p] = std::min(b2[p], ao[p] == bo[p] ? a2[p] : a1[p]);
+            a1[p] = b1[p];
+            ao[p] = bo[p];
+        } else {
+            a2[p] = std::min(a2[p], bo[p] == ao[p] ? b2[p] : b1[p]);
+        }
+    }
+}
+
+// When a pre-pass that spares work runs (the items-alone pre-pass: kAloneMinSpared, kAloneProbe
+// above; the settling pre-pass: kSettleMinSpared): per shape of call, the share of its triangles
+// that its last run spared (negative: none yet) and the calls since. Only the work depends on it.
+struct PayGuard {
     struct Shape {
+        std::uint32_t key = 0;   // the shape whose history this is (another shape that hashes here
+                                 // starts afresh: histories never mix)
         double spared = -1.0;
         unsigned off_calls = 0;  // calls without the pre-pass since it last ran
         unsigned wait = 1;       // ... before it runs again: doubled after each run that did not pay
     };
+    explicit PayGuard(double pays_from) : min_spared(pays_from) {}
+    double min_spared;  // a run that spares this share of the triangles or more pays
     std::array<Shape, kAloneShapes> shapes{};
     std::uint64_t last_spared = 0;  // the last call's spared triangles (0 without the pre-pass)
 
-    // The shape of a call: its object, item and triangle counts, each rounded to a power of two.
+    // The shape of a call: its object, item and triangle counts, each rounded (key_of).
     struct Call {
         std::size_t objects, items;
         std::uint64_t triangles;
     };
-    static std::size_t shape_of(const Call& c) {
-        const auto bw = [](std::uint64_t v) { return static_cast<std::size_t>(std::bit_width(v)); };
-        return (bw(c.objects) * 4099 + bw(c.items) * 67 + bw(c.triangles)) % kAloneShapes;
+    static Call call_of(std::span<const VisibilityItem> items) {
+        // (the objects are the runs of equal object ids: each object's items are consecutive)
+        Call c{0, items.size(), 0};
+        for (std::size_t i = 0; i < items.size(); ++i) {
+            c.objects += i == 0 || items[i].object != items[i - 1].object;
+            c.triangles += items[i].mesh.indices.size() / 3;
+        }
+        return c;
+    }
+    static std::uint32_t key_of(const Call& c) {
+        // Quarter octaves (the leading bit's place and the two bits after it): calls of one stage
+        // of one scene fall in few of them frame after frame, and other scenes' calls rarely share
+        // them (with whole octaves the cloth's first sub-object view had the shape of
+        // bunny-dragon's third, whose history then skipped both pre-passes there).
+        const auto q = [](std::uint64_t v) -> std::uint32_t {
+            if (v < 4) return static_cast<std::uint32_t>(v);
+            const int b = std::bit_width(v);
+            return static_cast<std::uint32_t>(b) * 4 + static_cast<std::uint32_t>((v >> (b - 3)) & 3u);
+        };
+        return q(c.objects) << 20 | q(c.items) << 10 | q(c.triangles);  // (each < 2^10)
+    }
+    Shape& shape_of(const Call& c) {
+        const std::uint32_t key = key_of(c);
+        Shape& sh = shapes[((key >> 20) * 4099 + ((key >> 10) & 0x3ffu) * 67 + (key & 0x3ffu)) % kAloneShapes];
+        if (sh.key != key) sh = Shape{key};
+        return sh;
     }
     bool wanted(const Call& call) {
         last_spared = 0;
         if (call.triangles < kAloneMinTriangles) return true;
-        Shape& sh = shapes[shape_of(call)];
-        if (sh.spared < 0.0 || sh.spared >= kAloneMinSpared) return true;
+        Shape& sh = shape_of(call);
+        if (sh.spared < 0.0 || sh.spared >= min_spared) return true;
         if (++sh.off_calls < sh.wait) return false;
         sh.off_calls = 0;
         return true;
@@ -214,9 +301,12 @@ struct AloneGuard {
     void record(const Call& call, std::uint64_t spared_now) {
         last_spared = spared_now;
         if (call.triangles < kAloneMinTriangles) return;
-        Shape& sh = shapes[shape_of(call)];
+        Shape& sh = shape_of(call);
         sh.spared = static_cast<double>(spared_now) / static_cast<double>(call.triangles);
-        sh.wait = sh.spared >= kAloneMinSpared ? 1 : std::min(2 * sh.wait, kAloneProbe);
+        // (a run far from paying, under half the share, waits twice as long again)
+        sh.wait = sh.spared >= min_spared         ? 1
+                  : sh.spared >= 0.5 * min_spared ? std::min(2 * sh.wait, kAloneProbe)
+                                                  : std::min(4 * sh.wait, kAloneProbe);
     }
 };
 
@@ -273,9 +363,50 @@ struct VisibilityPass::State {
     std::vector<std::uint8_t> occ_state;                   // per cell: kOccNone / kOccOne / kOccMany
     std::vector<std::vector<std::uint32_t>> part_occ_obj;  // split_pass: per part, its own cells
     std::vector<std::vector<std::uint8_t>> part_occ_state;
-    AloneGuard guard;
+    PayGuard guard{kAloneMinSpared};
+    PayGuard settle_guard{kSettleMinSpared};
+    // The settling pre-pass (presettle): per item, its boxes with encoded depth bounds and its
+    // window vertices' records (each in slots reserved per item: a box per triangle, a record per
+    // index); its verdict, and whether its fragments are tested.
+    struct BoxBound {
+        std::int16_t x0, y0, x1, y1;  // inclusive (one tile: <= 128 a side)
+        std::uint32_t lo, hi;
+    };
+    struct VertexRec {
+        std::uint32_t pixel;
+        std::uint32_t zmax;  // <= the zmax of the item's fragment at `pixel`
+    };
+    std::vector<BoxBound> boxes;
+    std::vector<VertexRec> vrec;
+    std::vector<std::size_t> box_first, rec_first;  // per item, its first slot; then the slot count
+    std::vector<std::uint32_t> box_count, rec_count;  // per item
+    std::vector<std::uint8_t> verdict;  // per item: kOpen, kNotHit, kHit
+    std::vector<std::uint8_t> tested;   // per item of the pass: its fragments are tested
+    // Per part of the pre-pass, per pixel: the minima of the boxes' lo (c*) and of the vertices'
+    // zmin bounds (v*), the open items' largest hi + 1 by object (u*, 0: none). Merged into part 0.
+    struct PrePart {
+        std::vector<std::uint32_t> c1, co, c2, v1, vo, v2, uo;
+        std::vector<std::uint64_t> u1, u2;
+        std::vector<std::uint32_t> vstamp;  // per vertex of the current run: marked in generation gen
+        std::vector<VertexRec> vcache;      // per vertex: its pixel (kNoObject: outside) and zmax bound
+        std::uint32_t gen = 0;
+    };
+    std::vector<PrePart> pre;
+    std::vector<std::size_t> pre_first;    // per part, its first item; then the item count
+    std::vector<std::uint8_t> pre_failed;  // per part: an input check failed
+    std::vector<std::uint64_t> pre_area;
+    std::vector<std::uint8_t> drawn;              // per item: in `reduced`
+    std::vector<VisibilityItem> reduced;          // the items drawn, in order
+    std::vector<std::uint32_t> reduced_at;        // per item: its index in `reduced` (if drawn)
+    std::uint64_t last_settled = 0;
+    PresettleStats settled;  // of the last run()
+    bool presettle_on = true;
+    // 0: not applied (input that fails a check, or large triangles: the caller goes on as without
+    // it); 1: verdict[], reduced[], reduced_at[] and tested[] (per item of `reduced`) are set; 2:
+    // every item has a verdict (nothing to draw).
+    int presettle(int width, int height, DepthFormat format, std::span<const VisibilityItem> items, int threads);
     // guard.record() after a call that ran the pre-pass.
-    void alone_record(std::span<const VisibilityItem> items, const AloneGuard::Call& call);
+    void alone_record(std::span<const VisibilityItem> items, const PayGuard::Call& call);
     // Items [first, last): reach[i], and their reach marked into the cells obj / state.
     void mark(const detail::FrontEndParams& params, std::span<const VisibilityItem> items, DepthFormat format,
               const detail::CellGrid& g, std::size_t first, std::size_t last, std::uint32_t* obj, std::uint8_t* state);
@@ -410,7 +541,7 @@ void VisibilityPass::State::alone(const detail::CellGrid& g, DepthFormat format,
     skip[i] = occ_alone(g, occ_state.data(), reach[i], DepthTarget::encode_clear(1.0, format)) ? 1 : 0;
 }
 
-void VisibilityPass::State::alone_record(std::span<const VisibilityItem> items, const AloneGuard::Call& call) {
+void VisibilityPass::State::alone_record(std::span<const VisibilityItem> items, const PayGuard::Call& call) {
     std::uint64_t spared = 0;
     for (std::size_t i = 0; i < items.size(); ++i)
         if (skip[i]) spared += items[i].mesh.indices.size() / 3;
@@ -453,15 +584,7 @@ inline void VisibilityPass::State::draw(std::span<const VisibilityItem> items, c
             last_lo = zlo;
             zmin = detail::quantize_down(zlo - mz, format);
         }
-        if (obj == tile_obj1[p]) {
-            tile_min1[p] = std::min(tile_min1[p], zmin);
-        } else if (zmin < tile_min1[p]) {
-            tile_min2[p] = tile_min1[p];
-            tile_min1[p] = zmin;
-            tile_obj1[p] = obj;
-        } else {
-            tile_min2[p] = std::min(tile_min2[p], zmin);
-        }
+        min_by_object(tile_min1, tile_obj1, tile_min2, p, obj, zmin);
         if (!keep) return;
         if (!(zhi == last_hi)) {
             last_hi = zhi;
@@ -513,7 +636,7 @@ void VisibilityPass::State::shade(std::span<const VisibilityItem> items, const T
     for (std::size_t j = 0; j < tile_bin.size(); ++j) {
         const Ref r = tile_bin[j];
         const std::uint32_t other = items[r.item].object == o1 ? m2 : m1;
-        const bool n = tris[r.item][r.tri].zq_hi >= other && !found(r.item);
+        const bool n = tested[r.item] && tris[r.item][r.tri].zq_hi >= other && !found(r.item);
         tile_need[j] = n ? 1 : 0;
         any = any || n;
     }
@@ -540,11 +663,11 @@ void VisibilityPass::State::shade(std::span<const VisibilityItem> items, const T
     if (one_tile) {
         for (std::size_t i = 0; i < items.size(); ++i)
             for (std::size_t k = 0; k < tris[i].size(); ++k)
-                draw({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)}, true);
+                draw({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)}, tested[i] != 0);
     } else if (settle) {
         for (std::size_t j = 0; j < tile_bin.size(); ++j) draw(tile_bin[j], tile_need[j] != 0);
     } else {
-        for (const Ref& r : tile_bin) draw(r, true);
+        for (const Ref& r : tile_bin) draw(r, tested[r.item] != 0);
     }
     test_fragments(items, tile_frags, tile_min1, tile_obj1, tile_min2);
 }
@@ -582,19 +705,8 @@ void VisibilityPass::State::mark_parts(const detail::FrontEndParams& params, std
     });
     occ_obj.assign(part_occ_obj[0].begin(), part_occ_obj[0].begin() + static_cast<std::ptrdiff_t>(g.count()));
     occ_state.assign(part_occ_state[0].begin(), part_occ_state[0].begin() + static_cast<std::ptrdiff_t>(g.count()));
-    for (std::size_t part = 1; part < n_parts; ++part) {
-        const std::uint32_t* bo = part_occ_obj[part].data();
-        const std::uint8_t* bs = part_occ_state[part].data();
-        for (std::size_t c = 0; c < g.count(); ++c) {
-            if (bs[c] == kOccNone) continue;
-            if (occ_state[c] == kOccNone) {
-                occ_state[c] = bs[c];
-                occ_obj[c] = bo[c];
-            } else if (bs[c] == kOccMany || occ_obj[c] != bo[c]) {
-                occ_state[c] = kOccMany;
-            }
-        }
-    }
+    for (std::size_t part = 1; part < n_parts; ++part)
+        merge_occ(occ_obj.data(), occ_state.data(), part_occ_obj[part].data(), part_occ_state[part].data(), g.count());
 }
 
 // The one-tile pass split by items (issue #16: R-CULLIDE's 32^2 views are one tile, so the tile
@@ -671,20 +783,9 @@ int VisibilityPass::State::split_pass(std::span<const VisibilityItem> items, con
     std::uint32_t* a1 = part_min1[0].data();
     std::uint32_t* ao = part_obj1[0].data();
     std::uint32_t* a2 = part_min2[0].data();
-    for (std::size_t part = 1; part < n_parts; ++part) {
-        const std::uint32_t* b1 = part_min1[part].data();
-        const std::uint32_t* bo = part_obj1[part].data();
-        const std::uint32_t* b2 = part_min2[part].data();
-        for (std::size_t p = 0; p < tile_pixels; ++p) {
-            if (b1[p] < a1[p]) {
-                a2[p] = std::min(b2[p], ao[p] == bo[p] ? a2[p] : a1[p]);
-                a1[p] = b1[p];
-                ao[p] = bo[p];
-            } else {
-                a2[p] = std::min(a2[p], bo[p] == ao[p] ? b2[p] : b1[p]);
-            }
-        }
-    }
+    for (std::size_t part = 1; part < n_parts; ++part)
+        merge_min_by_object(a1, ao, a2, part_min1[part].data(), part_obj1[part].data(), part_min2[part].data(),
+                            tile_pixels);
     hit.assign(items.size(), 0);
     detail::parallel_for(threads, n_parts,
                          [&](std::size_t part) { test_fragments(items, part_frags[part], a1, ao, a2); });
@@ -705,12 +806,290 @@ void VisibilityPass::State::raster_part(std::span<const VisibilityItem> items, c
     out.clear();
     for (std::size_t i = part_first[part]; i < part_first[part + 1]; ++i)
         for (std::size_t k = 0; k < tris[i].size(); ++k)
-            draw(items, {static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)}, true, 0, 0, width - 1, height - 1,
-                 side, format, m1.data(), o1.data(), m2.data(), out);
+            draw(items, {static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(k)}, tested[i] != 0, 0, 0, width - 1,
+                 height - 1, side, format, m1.data(), o1.data(), m2.data(), out);
+}
+
+// The settling pre-pass (issue #16, "model only what a scene needs"). In R-CULLIDE's 32^2 views
+// most items' answers are already certain from bounds that cost a fraction of a setup, and most
+// items cannot change the answer of an item that is not. From the vertices alone
+// (detail::list_bounds: an item's pixel box, [lo, hi] holding every zmin and zmax of its fragments,
+// and, unclipped, its window vertices, setup's very values):
+//  - coarse minima: per pixel, min_by_object of lo over every item whose box holds the pixel. An
+//    item's fragments lie in its box with zmin >= lo, so at every pixel the coarse minimum over the
+//    objects other than o is <= the pass's (min2 / min1 over the fragments, the clear value on
+//    both sides).
+//  - vertex minima: per pixel, min_by_object of encode_near(z + kVertexSlack) over the window
+//    vertices in it. A triangle has a fragment at the pixel holding its vertex, with zmin <= that
+//    value (detail::kVertexSlack, encode_near), so the vertex minimum over the objects other than o
+//    is >= the pass's there.
+//  - an item with hi < the coarse minimum over the other objects at every pixel of its box is NOT
+//    hit: each of its fragments has zmax <= hi < the pass's minimum there.
+//  - an item with a vertex whose zmax bound, encode_near(z - kVertexSlack), is >= the vertex minimum
+//    over the other objects at its pixel IS hit: that fragment's zmax >= the bound >= the pass's
+//    minimum there.
+//  - the other items are open. The pass then draws only the open items and the items whose box
+//    reaches a pixel where an open item of another object has a box with hi >= their lo, and tests
+//    only the open items' fragments. At a pixel where an open item of object o has a fragment of
+//    zmax z, an item left out is either of object o (not in the minimum over the objects other
+//    than o) or has zmin >= lo > that item's hi >= z, and a minimum is <= z with or without values
+//    above z: every tested fragment gets the answer it gets in the full pass.
+// So the answers are the full pass's bit for bit (the settled items take their verdicts), for any
+// thread count: every step is a function of the input (the parts' minima merge exactly, as the split
+// pass's do). The alone pre-pass is not run then: an item it would spare is settled here (no other
+// object's box reaches its pixels, so hi < the clear value settles it) and left out.
+namespace {
+// max_by_object: min_by_object's twin for maxima (0 = none): m1 the largest value with its object
+// o1, m2 the largest of any object other than o1.
+inline void max_by_object(std::uint64_t* m1, std::uint32_t* o1, std::uint64_t* m2, std::size_t p, std::uint32_t obj,
+                          std::uint64_t z) {
+    const std::uint64_t a = m1[p], b = m2[p];
+    const std::uint32_t ao = o1[p];
+    const bool same = obj == ao;
+    const bool above = z > a;
+    m1[p] = above ? z : a;
+    o1[p] = !same && above ? obj : ao;
+    m2[p] = same ? b : above ? a : std::max(b, z);
+}
+void merge_max_by_object(std::uint64_t* a1, std::uint32_t* ao, std::uint64_t* a2, const std::uint64_t* b1,
+                         const std::uint32_t* bo, const std::uint64_t* b2, std::size_t pixels) {
+    for (std::size_t p = 0; p < pixels; ++p) {
+        if (b1[p] > a1[p]) {
+            a2[p] = std::max(b2[p], ao[p] == bo[p] ? a2[p] : a1[p]);
+            a1[p] = b1[p];
+            ao[p] = bo[p];
+        } else {
+            a2[p] = std::max(a2[p], bo[p] == ao[p] ? b2[p] : b1[p]);
+        }
+    }
+}
+}  // namespace
+
+int VisibilityPass::State::presettle(int width, int height, DepthFormat format, std::span<const VisibilityItem> items,
+                                     int threads) {
+    const std::size_t n = items.size();
+    const detail::FrontEndParams params = front_end_params(width, height);
+    const auto w = static_cast<std::size_t>(width);
+    const std::size_t pixels = w * static_cast<std::size_t>(height);
+    const std::uint32_t clear = DepthTarget::encode_clear(1.0, format);
+    box_first.resize(n + 1);
+    rec_first.resize(n + 1);
+    std::size_t total = 0, total_boxes = 0;  // indices, box slots
+    for (std::size_t i = 0; i < n; ++i) {
+        box_first[i] = total_boxes;
+        rec_first[i] = total;
+        total += items[i].mesh.indices.size();
+        total_boxes += std::max<std::size_t>(1, items[i].mesh.indices.size() / 3);
+    }
+    box_first[n] = total_boxes;
+    rec_first[n] = total;
+    if (total == 0) return 0;
+    vrec.resize(total);
+    boxes.resize(total_boxes);
+    box_count.resize(n);
+    rec_count.resize(n);
+    verdict.resize(n);
+    drawn.resize(n);
+    // Every pixel of item i's boxes while f(box, pixel) is true; false when f stopped it.
+    const auto for_pixels = [&](std::size_t i, auto&& f) __attribute__((always_inline)) {
+        for (std::size_t b = box_first[i]; b < box_first[i] + box_count[i]; ++b) {
+            const BoxBound& t = boxes[b];
+            for (int py = t.y0; py <= t.y1; ++py)
+                for (int px = t.x0; px <= t.x1; ++px)
+                    if (!f(t, static_cast<std::size_t>(py) * w + static_cast<std::size_t>(px))) return false;
+        }
+        return true;
+    };
+    // Parts of about equal index counts at item boundaries (the input decides them), each with its
+    // own per-pixel records, merged in part order after each phase.
+    const std::size_t n_parts =
+        threads > 1 ? std::max<std::size_t>(1, std::min<std::size_t>(static_cast<std::size_t>(threads) * 2,
+                                                                      total / kPresettlePartIndices))
+                    : 1;
+    std::vector<std::size_t>& first = pre_first;
+    first.assign(n_parts + 1, n);
+    first[0] = 0;
+    for (std::size_t i = 0, part = 1; i < n && part < n_parts; ++i)
+        while (part < n_parts && rec_first[i] * n_parts >= total * part) first[part++] = i;
+    if (pre.size() < n_parts) pre.resize(n_parts);
+    pre_failed.assign(n_parts, 0);
+    pre_area.assign(2 * n_parts, 0);  // per part: pixels of its boxes; then per part: its triangles
+    PrePart& m = pre[0];              // the merged records
+
+    // 1. Boxes and the coarse minima; window vertices, the vertex minima and the records. A vertex
+    // shared by several items of a run of one object and one vertex array is mapped and marked once
+    // per part (its pixel and zmax bound kept in vcache, stamped with the run's generation).
+    const detail::WindowMap window(params);
+    detail::parallel_for(threads, n_parts, [&](std::size_t part) {
+        PrePart& ps = pre[part];
+        ps.c1.assign(pixels, clear);
+        ps.co.assign(pixels, kNoObject);
+        ps.c2.assign(pixels, clear);
+        ps.v1.assign(pixels, clear);
+        ps.vo.assign(pixels, kNoObject);
+        ps.v2.assign(pixels, clear);
+        const Double4* run_vertices = nullptr;
+        std::uint32_t run_object = kNoObject;
+        std::uint64_t box_area = 0, triangles = 0;
+        for (std::size_t i = first[part]; i < first[part + 1]; ++i) {
+            // The next item's vertices, where a mesh is larger than the caches (bunny-dragon: its
+            // items' vertices are scattered over megabytes).
+            if (i + 1 < first[part + 1] && items[i + 1].mesh.vertices.size() > kPrefetchVertices) {
+                const MeshViewD& next = items[i + 1].mesh;
+                for (std::size_t k = 0; k < next.indices.size() && k < 48; ++k)
+                    if (next.indices[k] < next.vertices.size()) __builtin_prefetch(next.vertices.data() + next.indices[k]);
+            }
+            const std::uint32_t obj = items[i].object;
+            BoxBound* bx = boxes.data() + box_first[i];
+            std::uint32_t nbox = 0;
+            std::uint64_t item_area = 0;
+            const detail::ListBounds b = detail::list_bounds(
+                params, items[i].mesh, format, [&](int x0, int y0, int x1, int y1, std::uint32_t lo, std::uint32_t hi) {
+                    bx[nbox++] = {static_cast<std::int16_t>(x0), static_cast<std::int16_t>(y0),
+                                  static_cast<std::int16_t>(x1), static_cast<std::int16_t>(y1), lo, hi};
+                    item_area += static_cast<std::uint64_t>(x1 - x0 + 1) * static_cast<std::uint64_t>(y1 - y0 + 1);
+                    for (int py = y0; py <= y1; ++py)
+                        for (int px = x0; px <= x1; ++px)
+                            min_by_object(ps.c1.data(), ps.co.data(), ps.c2.data(),
+                                          static_cast<std::size_t>(py) * w + static_cast<std::size_t>(px), obj, lo);
+                });
+            if (!b.ok) {
+                pre_failed[part] = 1;
+                return;
+            }
+            box_count[i] = nbox;
+            verdict[i] = kOpen;
+            if (nbox > 0 && b.inside) {  // (a clipped item's box, the whole target, says nothing of its size)
+                box_area += item_area;
+                triangles += items[i].mesh.indices.size() / 3;
+            }
+            std::uint32_t nrec = 0;
+            if (b.inside) {  // its window vertices: the vertex minima and its records
+                const MeshViewD& mesh = items[i].mesh;
+                if (mesh.vertices.data() != run_vertices || obj != run_object) {  // a new run: new stamps
+                    run_vertices = mesh.vertices.data();
+                    run_object = obj;
+                    if (ps.vstamp.size() < mesh.vertices.size()) {
+                        ps.vstamp.resize(mesh.vertices.size(), 0);
+                        ps.vcache.resize(mesh.vertices.size());
+                    }
+                    if (++ps.gen == 0) {
+                        std::fill(ps.vstamp.begin(), ps.vstamp.end(), 0u);
+                        ps.gen = 1;
+                    }
+                }
+                VertexRec* rec = vrec.data() + rec_first[i];
+                for (const std::uint32_t v : mesh.indices) {
+                    VertexRec& c = ps.vcache[v];
+                    if (ps.vstamp[v] != ps.gen) {
+                        ps.vstamp[v] = ps.gen;
+                        const detail::BoundsVertex wv = window(mesh.vertices[v]);
+                        if (!(wv.x >= 0.0 && wv.x < static_cast<double>(width) && wv.y >= 0.0 &&
+                              wv.y < static_cast<double>(height))) {
+                            c.pixel = kNoObject;  // outside the target: no fragment to name
+                            continue;
+                        }
+                        c.pixel = static_cast<std::uint32_t>(static_cast<std::size_t>(wv.y) * w +
+                                                             static_cast<std::size_t>(wv.x));
+                        // encode_near bounds quantize_down from above and quantize_up from below.
+                        c.zmax = detail::encode_near(wv.z - detail::kVertexSlack, format);
+                        min_by_object(ps.v1.data(), ps.vo.data(), ps.v2.data(), c.pixel, obj,
+                                      detail::encode_near(wv.z + detail::kVertexSlack, format));
+                    }
+                    if (c.pixel != kNoObject) rec[nrec++] = c;
+                }
+            }
+            rec_count[i] = nrec;
+        }
+        pre_area[part] = box_area;
+        pre_area[n_parts + part] = triangles;
+    });
+    std::uint64_t box_area = 0, triangles = 0;
+    for (std::size_t part = 0; part < n_parts; ++part) {
+        if (pre_failed[part]) return 0;  // the front end finds and reports it
+        box_area += pre_area[part];
+        triangles += pre_area[n_parts + part];
+    }
+    // Large triangles (kSettleMinArea pixels of box or more per triangle): the tiles settled from
+    // depth bounds instead.
+    if (triangles > 0 && box_area >= kSettleMinArea * triangles) return 0;
+    for (std::size_t part = 1; part < n_parts; ++part) {
+        merge_min_by_object(m.c1.data(), m.co.data(), m.c2.data(), pre[part].c1.data(), pre[part].co.data(),
+                            pre[part].c2.data(), pixels);
+        merge_min_by_object(m.v1.data(), m.vo.data(), m.v2.data(), pre[part].v1.data(), pre[part].vo.data(),
+                            pre[part].v2.data(), pixels);
+    }
+
+    // 2. Verdicts: certainly not hit (the coarse minima), certainly hit (the vertex minima), open;
+    // the open items' largest hi by object per pixel.
+    detail::parallel_for(threads, n_parts, [&](std::size_t part) {
+        PrePart& ps = pre[part];
+        ps.u1.assign(pixels, 0);
+        ps.uo.assign(pixels, kNoObject);
+        ps.u2.assign(pixels, 0);
+        for (std::size_t i = first[part]; i < first[part + 1]; ++i) {
+            const std::uint32_t obj = items[i].object;
+            const bool not_hit = for_pixels(i, [&](const BoxBound& t, std::size_t p) {
+                return t.hi < other_min(m.c1.data(), m.co.data(), m.c2.data(), p, obj);
+            });
+            if (not_hit) {
+                verdict[i] = kNotHit;
+                continue;
+            }
+            const VertexRec* rec = vrec.data() + rec_first[i];
+            bool hit_sure = false;
+            for (std::uint32_t k = 0; k < rec_count[i] && !hit_sure; ++k)
+                hit_sure = rec[k].zmax >= other_min(m.v1.data(), m.vo.data(), m.v2.data(), rec[k].pixel, obj);
+            if (hit_sure) {
+                verdict[i] = kHit;
+                continue;
+            }
+            for_pixels(i, [&](const BoxBound& t, std::size_t p) {
+                max_by_object(ps.u1.data(), ps.uo.data(), ps.u2.data(), p, obj, std::uint64_t{t.hi} + 1);
+                return true;
+            });
+        }
+    });
+    for (std::size_t part = 1; part < n_parts; ++part)
+        merge_max_by_object(m.u1.data(), m.uo.data(), m.u2.data(), pre[part].u1.data(), pre[part].uo.data(),
+                            pre[part].u2.data(), pixels);
+
+    // 3. The items drawn: the open ones, and those whose lo an open item of another object may meet.
+    detail::parallel_for(threads, n_parts, [&](std::size_t part) {
+        for (std::size_t i = first[part]; i < first[part + 1]; ++i) {
+            const std::uint32_t obj = items[i].object;
+            drawn[i] = verdict[i] == kOpen || !for_pixels(i, [&](const BoxBound& t, std::size_t p) {
+                return (m.uo[p] == obj ? m.u2[p] : m.u1[p]) <= t.lo;
+            });
+        }
+    });
+    reduced.clear();
+    tested.clear();
+    reduced_at.resize(n);
+    std::uint64_t drawn_indices = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!drawn[i]) continue;
+        reduced_at[i] = static_cast<std::uint32_t>(reduced.size());
+        reduced.push_back(items[i]);
+        tested.push_back(verdict[i] == kOpen ? 1 : 0);
+        drawn_indices += items[i].mesh.indices.size();
+    }
+    last_settled = (total - drawn_indices) / 3;
+    settled = PresettleStats{};
+    settled.ran = true;
+    for (std::size_t i = 0; i < n; ++i) {
+        settled.items_hit += verdict[i] == kHit;
+        settled.items_not_hit += verdict[i] == kNotHit;
+        settled.items_open += verdict[i] == kOpen;
+    }
+    settled.triangles_left_out = last_settled;
+    return reduced.empty() ? 2 : 1;
 }
 
 VisibilityPass::VisibilityPass() : s_(std::make_unique<State>()) {}
 std::uint64_t VisibilityPass::last_spared_triangles() const { return s_->guard.last_spared; }
+PresettleStats VisibilityPass::last_presettle() const { return s_->settled; }
+void VisibilityPass::set_presettle(bool on) { s_->presettle_on = on; }
 VisibilityPass::~VisibilityPass() = default;
 
 Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, DepthFormat format,
@@ -727,29 +1106,60 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
     threads = detail::effective_threads(threads);
     if (items.size() >= kNoObject) return Error{"visibility pass: too many items (limit 2^32 - 1)"};
     State& s = *s_;
-    // One-tile targets with enough triangles for every thread: the split pass, front end included.
-    std::uint64_t submitted = 0;
-    for (const VisibilityItem& it : items) submitted += it.mesh.indices.size() / 3;
     const int one_side = tile_side(width, height);
     const bool one_tile = one_side >= width && one_side >= height;
-    // The call's shape for the items-alone pre-pass's history (AloneGuard): the objects are the
-    // runs of equal object ids (each object's items are consecutive).
-    AloneGuard::Call call{0, items.size(), submitted};
-    for (std::size_t i = 0; i < items.size(); ++i) call.objects += i == 0 || items[i].object != items[i - 1].object;
-    const bool use_alone = s.guard.wanted(call);
+    // On one-tile targets the settling pre-pass first: the items it settles take their verdicts,
+    // and the pass below runs on `work`, the same items with only the triangles that can change an
+    // open item's answer (State::presettle).
+    s.last_settled = 0;
+    s.settled = PresettleStats{};
+    int presettled = 0;
+    const PayGuard::Call whole = PayGuard::call_of(items);
+    if (one_tile && s.presettle_on) {
+        if (s.settle_guard.wanted(whole)) {
+            presettled = s.presettle(width, height, format, items, threads);
+            s.settle_guard.record(whole, s.last_settled);
+        }
+    }
+    const std::span<const VisibilityItem> all_items = items;
+    const auto answer = [&]() {
+        std::vector<std::uint8_t> out(all_items.size());
+        for (std::size_t i = 0; i < out.size(); ++i)
+            out[i] = presettled == 0              ? s.hit[i]
+                     : s.verdict[i] == kOpen      ? s.hit[s.reduced_at[i]]
+                     : s.verdict[i] == kHit       ? 1
+                                                  : 0;
+        return out;
+    };
+    if (presettled == 2) {
+        s.guard.last_spared = 0;
+        s.hit.assign(items.size(), 0);
+        return answer();
+    }
+    if (presettled == 1) items = s.reduced;
+    if (presettled == 0) s.tested.assign(items.size(), 1);
+    // The call's shape for the items-alone pre-pass's history (PayGuard). Not with the settling
+    // pre-pass, which settles what it would spare.
+    const PayGuard::Call call = presettled == 0 ? whole : PayGuard::call_of(items);
+    // One-tile targets with enough triangles for every thread: the split pass, front end included.
+    const std::uint64_t submitted = call.triangles;
+    bool use_alone = false;
+    if (presettled == 0)
+        use_alone = s.guard.wanted(call);
+    else
+        s.guard.last_spared = 0;
     if (one_tile && threads > 1 && submitted >= kSplitMinTriangles * static_cast<std::uint64_t>(threads)) {
         // A few runs per thread, so that runs of small and of large triangles even out between them.
         const std::size_t parts = static_cast<std::size_t>(std::min<std::uint64_t>(
             static_cast<std::uint64_t>(threads) * kSplitRunsPerThread, submitted / kSplitMinTriangles * kSplitRunsPerThread / 2));
         const int split =
             s.split_pass(items, one_side, width, height, format, threads, std::max<std::size_t>(parts, 2), use_alone);
-        if (split == 0) return validate(items);
+        if (split == 0) return validate(all_items);
         if (use_alone) s.alone_record(items, call);
-        if (split == 1)
-            return std::vector<std::uint8_t>(s.hit.begin(), s.hit.begin() + static_cast<std::ptrdiff_t>(items.size()));
+        if (split == 1) return answer();
         // split == 2: large triangles, set up; the settled path below.
     } else if (!s.front_end(width, height, format, items, threads, use_alone)) {
-        return validate(items);
+        return validate(all_items);
     } else if (use_alone) {
         s.alone_record(items, call);
     }
@@ -774,8 +1184,7 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
     detail::parallel_for(threads, grid.count(),
                          [&](std::size_t tile) { s.shade(items, grid, width, height, format, tile, settle); });
 
-    std::vector<std::uint8_t> result(s.hit.begin(), s.hit.begin() + static_cast<std::ptrdiff_t>(items.size()));
-    return result;
+    return answer();
 }
 
 }  // namespace raster

@@ -6,6 +6,8 @@
 // the item's two queries passed a sample" from raster::execute and raster::execute_reference.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -107,6 +109,12 @@ std::vector<std::uint8_t> recorded(const Scene& s, int w, int h, DepthFormat f, 
             if (r.value()[q] != 0) any[query_item[q]] = 1;
     }
     return any;
+}
+
+std::uint64_t crowded_triangles(const Scene& s) {
+    std::uint64_t n = 0;
+    for (const auto& idx : s.item_indices) n += idx.size() / 3;
+    return n;
 }
 
 std::vector<raster::VisibilityItem> items_of(const Scene& s) {
@@ -265,10 +273,15 @@ TEST_CASE("The fused visibility pass: items alone in the view are skipped with t
         for (const int threads : {1, 2, 3, 8}) {
             CAPTURE(threads);
             raster::VisibilityPass pass;  // fresh: the pre-pass runs on a first call
+            pass.set_presettle(false);    // (which would settle these items first on one tile)
             auto got = pass.run(w, h, f, items_of(s), threads);
             REQUIRE_MESSAGE(got.ok(), got.error().message);
             CHECK(got.value() == want);
             if (pass.last_spared_triangles() > 0) ++spared_runs;
+            raster::VisibilityPass settling;
+            auto settled = settling.run(w, h, f, items_of(s), threads);
+            REQUIRE_MESSAGE(settled.ok(), settled.error().message);
+            CHECK(settled.value() == want);
         }
         for (auto v : want) (v != 0 ? hidden : visible) += 1;
     }
@@ -309,6 +322,7 @@ TEST_CASE("The fused visibility pass: the pre-pass's history of one scene does n
     for (const int threads : {1, 2}) {
         CAPTURE(threads);
         raster::VisibilityPass pass;
+        pass.set_presettle(false);  // the alone pre-pass's history (the settling one has its own)
         for (int call = 0; call < 40; ++call) {
             auto r = pass.run(32, 32, DepthFormat::D24, items_of(crowded), threads);
             REQUIRE(r.ok());
@@ -345,21 +359,34 @@ TEST_CASE("The fused visibility pass: items that touch only at a pixel border ar
             // the two still share the closed squares' border column, again hidden.
             CHECK(want[0] == 1);
             for (const int threads : {1, 2}) {
-                raster::VisibilityPass pass;
-                auto r = pass.run(32, 32, f, items, threads);
-                REQUIRE(r.ok());
-                CHECK(r.value() == want);
+                for (const bool settling : {false, true}) {
+                    raster::VisibilityPass pass;
+                    pass.set_presettle(settling);
+                    auto r = pass.run(32, 32, f, items, threads);
+                    REQUIRE(r.ok());
+                    CHECK(r.value() == want);
+                    // The settling pre-pass must not take the far one for certainly not hit.
+                    CHECK(pass.last_presettle().items_not_hit == (settling ? 1 : 0));
+                }
             }
-            // Moved two pixel columns further away, both are alone: the pre-pass spares both.
+            // Moved two pixel columns further away, both are alone: the pre-pass spares both (and
+            // the settling pre-pass settles both: nothing is drawn).
             std::vector<Double4> apart = v;
             for (int k = 3; k < 6; ++k) apart[static_cast<std::size_t>(k)].x += 4.0 / 32.0;
             const std::vector<raster::VisibilityItem> items_apart = {{raster::MeshViewD{apart, a}, 0},
                                                                      {raster::MeshViewD{apart, b}, 1}};
             raster::VisibilityPass pass;
+            pass.set_presettle(false);
             auto r = pass.run(32, 32, f, items_apart, 1);
             REQUIRE(r.ok());
             CHECK(r.value() == std::vector<std::uint8_t>{0, 0});
             CHECK(pass.last_spared_triangles() == 2);
+            pass.set_presettle(true);
+            r = pass.run(32, 32, f, items_apart, 1);
+            REQUIRE(r.ok());
+            CHECK(r.value() == std::vector<std::uint8_t>{0, 0});
+            CHECK(pass.last_presettle().items_not_hit == 2);
+            CHECK(pass.last_presettle().triangles_left_out == 2);
         }
     }
 }
@@ -383,11 +410,204 @@ TEST_CASE("The fused visibility pass: an item of scattered triangles reaches eac
         CHECK(want == std::vector<std::uint8_t>{0, 1, 0});
         for (const int threads : {1, 2}) {
             raster::VisibilityPass pass;
+            pass.set_presettle(false);
             auto r = pass.run(32, 32, f, items_of(s), threads);
             REQUIRE(r.ok());
             CHECK(r.value() == want);
             CHECK(pass.last_spared_triangles() == 1);  // the middle one only
+            // The settling pre-pass (a box per scattered triangle): the hidden item is certainly
+            // hit (a vertex of the near triangle shares its pixel), the other two certainly not.
+            pass.set_presettle(true);
+            r = pass.run(32, 32, f, items_of(s), threads);
+            REQUIRE(r.ok());
+            CHECK(r.value() == want);
+            CHECK(pass.last_presettle().items_hit == 1);
+            CHECK(pass.last_presettle().items_not_hit == 2);
+            CHECK(pass.last_presettle().triangles_left_out == 4);
         }
+    }
+}
+
+// Objects that are meshes (grid patches whose quads share vertices), cut into items of 4
+// triangles as R-CULLIDE's sub-objects: the settling pre-pass (visibility.cpp, State::presettle)
+// maps each shared vertex once per run of one object. Patches overlap in the window and in depth;
+// some are flat at one shared depth (ties between objects), some reach the far plane, some leave
+// the clip volume (clipped: bounds_reach's boxes), some have their vertices on pixel borders
+// (snap_x, snap_y: a pixel's width in clip units; 0: none), and some come in touching pairs: the
+// second patch starts at the first one's far edge, at the same positions and depths (or a hair
+// behind), and goes on behind (contact, where the pre-pass's bounds are tightest); all_pairs: every
+// patch is such a pair.
+// `size`: a patch's side in clip units (2 = the target).
+Scene patch_scene(test::Rng& rng, int objects, double size, bool clipped = true, double snap_x = 0.0,
+                  double snap_y = 0.0, bool all_pairs = false) {
+    Scene s;
+    s.objects = static_cast<std::uint32_t>(objects);
+    const double tie_z = rng.uniform(-0.3, 0.3);
+    const auto snap = [](double v, double step) { return step > 0.0 ? std::round((v + 1.0) / step) * step - 1.0 : v; };
+    for (int o = 0; o < objects; ++o) {
+        const int gx = 2 + static_cast<int>(rng.below(6)), gy = 1 + static_cast<int>(rng.below(4));
+        const double cx = rng.uniform(-0.95, 0.95), cy = rng.uniform(-0.95, 0.95);
+        const double sx = size * rng.uniform(0.3, 1.0), sy = size * rng.uniform(0.3, 1.0);
+        const int kind = all_pairs ? 3 : static_cast<int>(rng.below(10));
+        const bool pair = kind == 3 && o + 1 < objects;
+        const bool snapped = kind == 4 || (pair && rng.coin());
+        const double z0 = kind == 0 ? tie_z : kind == 1 ? 1.0 : rng.uniform(-0.9, 0.6);
+        // (half the pairs level along their shared edge, so that one depth bounds a whole item there)
+        const double ax = kind <= 1 || (pair && rng.coin()) ? 0.0 : rng.uniform(-0.5, 0.5);
+        const double ay = kind <= 1 ? 0.0 : pair ? rng.uniform(0.05, 0.5) : rng.uniform(-0.5, 0.5);
+        std::vector<Double4> grid;
+        for (int j = 0; j <= gy; ++j)
+            for (int i = 0; i <= gx; ++i) {
+                const double u = static_cast<double>(i) / gx - 0.5, v = static_cast<double>(j) / gy - 0.5;
+                Double4 p{cx + u * sx, cy + v * sy, z0 + ax * u * sx + ay * v * sy, 1.0};
+                if (snapped) p.x = snap(p.x, snap_x), p.y = snap(p.y, snap_y);
+                if (kind >= 2 && !pair) p.z += rng.uniform(-0.01, 0.01);
+                if (clipped && kind == 2 && i == 0) p.x -= 1.5;  // leaves the clip volume: clipped
+                p.z = std::clamp(p.z, -1.0, 1.0);
+                grid.push_back(p);
+            }
+        const auto add = [&](const std::vector<Double4>& g, std::uint32_t object) {
+            const auto base = static_cast<std::uint32_t>(s.vertices.size());
+            s.vertices.insert(s.vertices.end(), g.begin(), g.end());
+            std::vector<std::uint32_t> tris;
+            const auto at = [&](int i, int j) { return base + static_cast<std::uint32_t>(j * (gx + 1) + i); };
+            for (int j = 0; j < gy; ++j)
+                for (int i = 0; i < gx; ++i) {
+                    tris.insert(tris.end(), {at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+                    tris.insert(tris.end(), {at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+                }
+            for (std::size_t k = 0; k < tris.size(); k += 12) {
+                s.item_indices.emplace_back(tris.begin() + static_cast<std::ptrdiff_t>(k),
+                                            tris.begin() + static_cast<std::ptrdiff_t>(std::min(tris.size(), k + 12)));
+                s.item_object.push_back(object);
+            }
+        };
+        add(grid, static_cast<std::uint32_t>(o));
+        if (!pair) continue;
+        // The partner: the patch reflected across its far (last) row, in y and in depth, so it
+        // shares that row exactly and lies behind it everywhere else; half the partners start up to
+        // one D16 step (2 / 65535 in clip z) further back, so that the two straddle a quantization
+        // step by a hair (where the pre-pass's cheap encodings must still bound the exact ones).
+        const double gap = rng.coin() ? 0.0 : rng.uniform(0.0, 2.0 / 65535.0);
+        std::vector<Double4> mirror(grid.size());
+        for (int j = 0; j <= gy; ++j)
+            for (int i = 0; i <= gx; ++i) {
+                const Double4& edge = grid[static_cast<std::size_t>(gy * (gx + 1) + i)];
+                const Double4& p = grid[static_cast<std::size_t>((gy - j) * (gx + 1) + i)];
+                mirror[static_cast<std::size_t>(j * (gx + 1) + i)] = {p.x, edge.y + (edge.y - p.y),
+                                                                      std::min(1.0, edge.z + gap + (edge.z - p.z)), 1.0};
+            }
+        ++o;
+        add(mirror, static_cast<std::uint32_t>(o));
+    }
+    return s;
+}
+
+TEST_CASE("The settling pre-pass gives the recorded answers, settling items and leaving triangles out") {
+    // visibility.cpp, State::presettle: items certainly hit (a vertex at or behind another object's
+    // vertex in one pixel), certainly not hit (in front of every other object's box), and open;
+    // only the open items and those near them in depth are drawn. Fresh passes (the pre-pass runs
+    // on a first call), one-tile targets of several sizes and shapes, every format, 1, 2, 3 and 8
+    // threads; the same answers as the recorded passes and as the pass without it.
+    test::Rng rng(20261128);
+    const DepthFormat formats[] = {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F};
+    const int sizes[][2] = {{32, 32}, {37, 23}, {64, 64}, {128, 96}};
+    raster::PresettleStats sum;
+    int ran = 0, runs = 0;
+    for (int rep = 0; rep < 24; ++rep) {
+        const DepthFormat f = formats[rep % 3];
+        const int w = sizes[(rep / 3) % 4][0], h = sizes[(rep / 3) % 4][1];
+        // Patches of 3 to 12 pixels: triangles of a pixel or two, as in R-CULLIDE's 32^2 views.
+        const double px = 2.0 / std::max(w, h);
+        const Scene s = patch_scene(rng, 10 + static_cast<int>(rng.below(100)), px * (3.0 + rng.uniform(0.0, 9.0)),
+                                    rep % 4 == 0, 2.0 / w, 2.0 / h);
+        CAPTURE(rep);
+        const std::vector<std::uint8_t> want = recorded(s, w, h, f, 1, true);
+        for (const int threads : {1, 2, 3, 8}) {
+            CAPTURE(threads);
+            raster::VisibilityPass off;
+            off.set_presettle(false);
+            auto plain = off.run(w, h, f, items_of(s), threads);
+            REQUIRE_MESSAGE(plain.ok(), plain.error().message);
+            CHECK(plain.value() == want);
+            raster::VisibilityPass pass;
+            auto got = pass.run(w, h, f, items_of(s), threads);
+            REQUIRE_MESSAGE(got.ok(), got.error().message);
+            CHECK(got.value() == want);
+            const raster::PresettleStats st = pass.last_presettle();
+            ++runs;
+            if (!st.ran) continue;
+            ++ran;
+            CHECK(st.items_hit + st.items_not_hit + st.items_open == s.item_indices.size());
+            sum.items_hit += st.items_hit;
+            sum.items_not_hit += st.items_not_hit;
+            sum.items_open += st.items_open;
+            sum.triangles_left_out += st.triangles_left_out;
+        }
+    }
+    // It ran on most calls, and every verdict occurred, so each rule was exercised against the
+    // recorded answers.
+    CHECK(ran > runs / 2);
+    CHECK(sum.items_hit > 5000);
+    CHECK(sum.items_not_hit > 3000);
+    CHECK(sum.items_open > 2000);
+    CHECK(sum.triangles_left_out > 20000);
+}
+
+TEST_CASE("The settling pre-pass: objects in contact, a hair apart across a quantization step, give the recorded answers") {
+    // Pairs of patches alone in the view that touch along an edge (the second starts at the first
+    // one's far edge, at the same depth or up to one D16 step behind: patch_scene's pairs). There
+    // the exact pass finds the front one hit or not by a single quantization step, and the
+    // pre-pass's cheap encodings (encode_below_down, encode_above_up, encode_near) must still bound
+    // the exact ones: a bound one step too tight settles the front item as not hit.
+    test::Rng rng(20261131);
+    const DepthFormat formats[] = {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F};
+    int hit = 0, visible = 0;
+    for (int rep = 0; rep < 300; ++rep) {
+        const double snap = rep % 2 == 0 ? 2.0 / 32.0 : 0.0;
+        const Scene s = patch_scene(rng, 2, 0.4, false, snap, snap, true);
+        const DepthFormat f = formats[rep % 3];
+        CAPTURE(rep);
+        const std::vector<std::uint8_t> want = recorded(s, 32, 32, f, 1, true);
+        raster::VisibilityPass pass;
+        auto got = pass.run(32, 32, f, items_of(s), 1);
+        REQUIRE(got.ok());
+        CHECK(got.value() == want);
+        for (auto v : want) (v != 0 ? hit : visible) += 1;
+    }
+    CHECK(hit > 100);
+    CHECK(visible > 100);
+}
+
+TEST_CASE("The settling pre-pass runs while it pays, and its history of one scene does not turn it off for another") {
+    // visibility.cpp, PayGuard with kSettleMinSpared: a call shape whose pre-pass left out less than
+    // 75% of the triangles runs without it on the next calls (now and then with it again); another
+    // shape still runs it. The answers never change.
+    test::Rng rng(20261130);
+    // Crowded: large patches all over each other, so most items stay open and much is drawn.
+    const Scene crowded = patch_scene(rng, 200, 0.5);
+    Scene apart = patch_scene(rng, 3, 0.1);  // three small patches: everything settled
+    for (const int threads : {1, 2}) {
+        CAPTURE(threads);
+        raster::VisibilityPass pass;
+        const std::vector<std::uint8_t> want = recorded(crowded, 32, 32, DepthFormat::D24, 1, true);
+        int ran = 0;
+        for (int call = 0; call < 40; ++call) {
+            auto r = pass.run(32, 32, DepthFormat::D24, items_of(crowded), threads);
+            REQUIRE(r.ok());
+            CHECK(r.value() == want);
+            if (pass.last_presettle().ran) {
+                ++ran;
+                CHECK(pass.last_presettle().triangles_left_out * 4 < 3 * crowded_triangles(crowded));
+            }
+        }
+        CHECK(ran >= 2);   // the first call, and probes
+        CHECK(ran <= 10);  // but not every call
+        auto r = pass.run(32, 32, DepthFormat::D24, items_of(apart), threads);
+        REQUIRE(r.ok());
+        CHECK(pass.last_presettle().ran);
+        CHECK(pass.last_presettle().triangles_left_out > 0);
+        CHECK(r.value() == recorded(apart, 32, 32, DepthFormat::D24, 1, true));
     }
 }
 

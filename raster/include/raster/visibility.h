@@ -45,6 +45,15 @@ struct VisibilityItem {
     std::uint32_t object = 0;
 };
 
+// What the settling pre-pass of one VisibilityPass::run() did.
+struct PresettleStats {
+    bool ran = false;
+    std::uint64_t items_hit = 0;      // certainly not fully visible
+    std::uint64_t items_not_hit = 0;  // certainly fully visible
+    std::uint64_t items_open = 0;     // answered by the pass
+    std::uint64_t triangles_left_out = 0;  // neither set up nor drawn
+};
+
 // Reusable state (buffers kept between calls, so a pipeline allocates only while they grow).
 class VisibilityPass {
    public:
@@ -68,6 +77,17 @@ class VisibilityPass {
     // runs while it pays (its last run on calls of this shape, object, item and triangle counts,
     // spared 30% or more of their triangles), and now and then otherwise; 0 when it did not run.
     [[nodiscard]] std::uint64_t last_spared_triangles() const;
+
+    // The settling pre-pass (on by default; visibility.cpp, State::presettle; docs/reliable-raster.md,
+    // "Items settled before drawing"): on targets of one tile (up to 128 pixels a side) the items
+    // whose answer bounds from the vertices alone already decide take it without drawing, and only
+    // the items that can change an open item's answer are set up and drawn. Work only: the answers
+    // are the same with it on or off (off: for tests and measurements). It runs while it pays (it
+    // left out 75% of a call's triangles or more the last time a call of this shape ran it), and now
+    // and then otherwise. last_presettle(): what it did in the last run() (ran = false when it did
+    // not run, or did not apply: larger targets, large triangles, input that fails a check).
+    void set_presettle(bool on);
+    [[nodiscard]] PresettleStats last_presettle() const;
 
    private:
     struct State;
