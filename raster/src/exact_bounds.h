@@ -348,6 +348,39 @@ inline std::uint32_t encode_above_up(double z, DepthFormat format) {
 // and both quantizations are monotone. A list with a larger coordinate may be clipped: bounds_reach's
 // boxes (pixels; they hold every record's box) with the widest encoded range. ok = false when an index or
 // vertex fails the input checks (the front end reports it; box may have been called).
+// list_bounds' box step for triangles inside the clip volume (every |coordinate| <= 1: M = 1), from
+// their window extremes (the window map is monotone, so the extremes of the window positions are
+// the map of the extremes): box(x0, y0, x1, y1, lo, hi) with the grown box cut to the target (none
+// when it is outside), lo and hi as list_bounds says. With spread_limit > 0 it calls nothing and
+// returns false when the box holds more pixels than that.
+struct WindowBoxer {
+    int width, height;
+    double m, mz;
+    DepthFormat format;
+    WindowBoxer(const FrontEndParams& params, DepthFormat f)
+        : width(params.target_width),
+          height(params.target_height),
+          m(kPixelMargin + kClipMarginRel * std::max(static_cast<double>(params.viewport.width) * 0.5,
+                                                     static_cast<double>(params.viewport.height) * 0.5)),
+          mz(kDepthMargin + kClipMarginRel),
+          format(f) {}
+    template <class Box>
+    bool operator()(double x0, double x1, double y0, double y1, double z0, double z1, std::size_t spread_limit,
+                    Box&& box) const {
+        const GrownBox g = grown_box(x0, x1, y0, y1, m);
+        if (g.outside(width, height)) return true;  // no fragment
+        int b[4];
+        g.cut(width, height, b[0], b[1], b[2], b[3]);
+        if (spread_limit > 0 &&
+            static_cast<std::size_t>(b[2] - b[0] + 1) * static_cast<std::size_t>(b[3] - b[1] + 1) > spread_limit)
+            return false;
+        const double slack = 0x1p-40 * std::max(std::fabs(z0), std::fabs(z1)) + 0x1p-1000;
+        box(b[0], b[1], b[2], b[3], encode_below_down((z0 - slack) - mz, format),
+            encode_above_up((z1 + slack) + mz, format));
+        return true;
+    }
+};
+
 struct ListBounds {
     bool ok = true;
     bool inside = false;
@@ -388,39 +421,24 @@ inline ListBounds list_bounds(const FrontEndParams& params, const MeshViewD& mes
     const double tx = static_cast<double>(vp.x) + hw;
     const double ty = static_cast<double>(vp.y) + hh;
     r.inside = true;
-    const double mc = kClipMarginRel;  // M = 1
-    const double m = kPixelMargin + mc * std::max(hw, hh);
-    const double mz = kDepthMargin + mc;
-    // The box of window extremes [x0, x1] x [y0, y1] and depths [z0, z1], cut to the target.
-    const auto emit = [&](double x0, double x1, double y0, double y1, double z0, double z1, bool spread_check) {
-        const GrownBox g = grown_box(x0, x1, y0, y1, m);
-        if (g.outside(params.target_width, params.target_height)) return true;  // no fragment
-        int b[4];
-        g.cut(params.target_width, params.target_height, b[0], b[1], b[2], b[3]);
-        if (spread_check && n > 3 &&
-            static_cast<std::size_t>(b[2] - b[0] + 1) * static_cast<std::size_t>(b[3] - b[1] + 1) >
-                static_cast<std::size_t>(kReachSpread) * (n / 3))
-            return false;
-        const double slack = 0x1p-40 * std::max(std::fabs(z0), std::fabs(z1)) + 0x1p-1000;
-        box(b[0], b[1], b[2], b[3], encode_below_down((z0 - slack) - mz, format),
-            encode_above_up((z1 + slack) + mz, format));
-        return true;
-    };
-    if (!emit(cx0 * hw + tx, cx1 * hw + tx, cy0 * hh + ty, cy1 * hh + ty, cz0 * 0.5 + 0.5, cz1 * 0.5 + 0.5, true)) {
+    const WindowBoxer boxer(params, format);
+    if (!boxer(cx0 * hw + tx, cx1 * hw + tx, cy0 * hh + ty, cy1 * hh + ty, cz0 * 0.5 + 0.5, cz1 * 0.5 + 0.5,
+               n > 3 ? kReachSpread * (n / 3) : 0, box)) {
         for (std::size_t k = 0; k < n; k += 3) {  // scattered: a box per triangle
             const Double4& a = mesh.vertices[mesh.indices[k]];
             const Double4& b = mesh.vertices[mesh.indices[k + 1]];
             const Double4& c = mesh.vertices[mesh.indices[k + 2]];
-            emit(std::min(std::min(a.x, b.x), c.x) * hw + tx, std::max(std::max(a.x, b.x), c.x) * hw + tx,
-                 std::min(std::min(a.y, b.y), c.y) * hh + ty, std::max(std::max(a.y, b.y), c.y) * hh + ty,
-                 std::min(std::min(a.z, b.z), c.z) * 0.5 + 0.5, std::max(std::max(a.z, b.z), c.z) * 0.5 + 0.5, false);
+            boxer(std::min(std::min(a.x, b.x), c.x) * hw + tx, std::max(std::max(a.x, b.x), c.x) * hw + tx,
+                  std::min(std::min(a.y, b.y), c.y) * hh + ty, std::max(std::max(a.y, b.y), c.y) * hh + ty,
+                  std::min(std::min(a.z, b.z), c.z) * 0.5 + 0.5, std::max(std::max(a.z, b.z), c.z) * 0.5 + 0.5, 0, box);
         }
     }
     return r;
 }
 
-// The window position of a vertex of a list that list_bounds found `inside`: the very values that
-// setup_bounds_triangle's unclipped path computes for it (the same operations on the same inputs).
+// The window position of a vertex with every |coordinate| <= 1: the very values that
+// setup_bounds_triangle computes for it, clipped or not (the same operations on the same inputs;
+// the clip keeps such a vertex unchanged).
 struct WindowMap {
     double hw, hh, tx, ty;
     explicit WindowMap(const FrontEndParams& params)
@@ -432,11 +450,14 @@ struct WindowMap {
 };
 
 // How far a reported depth range may lie from a window vertex's depth z inside the pixel: every
-// (zlo, zhi) reported for a pixel whose square holds a window vertex of an unclipped triangle has
-// zlo <= z + kVertexSlack and zhi >= z - kVertexSlack. The paths are conservative (each range holds
-// the polygon's depths over the grown square, up to roundings below 2^-40 of the depth range, far
-// smaller than this), and the vertex's own pixel is always reported (its square holds a point of
-// the polygon). Used only to settle answers early, so a larger slack loses speed, never an answer.
+// (zlo, zhi) reported for a pixel whose square holds the window position of a vertex with every
+// |coordinate| <= 1 has zlo <= z + kVertexSlack and zhi >= z - kVertexSlack, for every triangle
+// with that vertex. Such a vertex lies inside the grown clip volume, so every clip keeps it unchanged
+// and it is a vertex of the triangle's polygon, clipped or not, at WindowMap's position; the paths
+// are conservative (each range holds the polygon's depths over the grown square, up to roundings
+// below 2^-40 of the depth range, far smaller than this), and the vertex's own pixel is always
+// reported (its square holds a point of the polygon). Used only to settle answers early, so a
+// larger slack loses speed, never an answer.
 inline constexpr double kVertexSlack = 0x1p-30;
 
 // ---- the per-pixel traversal shared by bounds_rect and the fused visibility pass ----

@@ -376,6 +376,15 @@ struct VisibilityPass::State {
         std::uint32_t pixel;
         std::uint32_t zmax;  // <= the zmax of the item's fragment at `pixel`
     };
+    // A vertex as the pre-pass found it: an input check failed, beyond the clip cube (|coordinate|
+    // > 1), or inside it with its window position (setup's values), its pixel (kNoObject: outside
+    // the target) and the zmax bound of its fragment there.
+    struct VertexMap {
+        static constexpr std::uint8_t kBad = 0, kBeyond = 1, kInside = 2;
+        detail::BoundsVertex win;
+        std::uint32_t pixel, zmax;
+        std::uint8_t state;
+    };
     std::vector<BoxBound> boxes;
     std::vector<VertexRec> vrec;
     std::vector<std::size_t> box_first, rec_first;  // per item, its first slot; then the slot count
@@ -387,8 +396,8 @@ struct VisibilityPass::State {
     struct PrePart {
         std::vector<std::uint32_t> c1, co, c2, v1, vo, v2, uo;
         std::vector<std::uint64_t> u1, u2;
-        std::vector<std::uint32_t> vstamp;  // per vertex of the current run: marked in generation gen
-        std::vector<VertexRec> vcache;      // per vertex: its pixel (kNoObject: outside) and zmax bound
+        std::vector<std::uint32_t> vstamp;  // per vertex of the current run: mapped in generation gen
+        std::vector<VertexMap> vcache;      // per vertex: what the run found
         std::uint32_t gen = 0;
     };
     std::vector<PrePart> pre;
@@ -813,16 +822,17 @@ void VisibilityPass::State::raster_part(std::span<const VisibilityItem> items, c
 // The settling pre-pass (issue #16, "model only what a scene needs"). In R-CULLIDE's 32^2 views
 // most items' answers are already certain from bounds that cost a fraction of a setup, and most
 // items cannot change the answer of an item that is not. From the vertices alone
-// (detail::list_bounds: an item's pixel box, [lo, hi] holding every zmin and zmax of its fragments,
-// and, unclipped, its window vertices, setup's very values):
+// (detail::list_bounds and WindowBoxer: an item's pixel box, or a box per triangle, with [lo, hi]
+// holding every zmin and zmax of its fragments there; detail::WindowMap: the window position of each
+// vertex inside the clip cube, setup's very values):
 //  - coarse minima: per pixel, min_by_object of lo over every item whose box holds the pixel. An
 //    item's fragments lie in its box with zmin >= lo, so at every pixel the coarse minimum over the
 //    objects other than o is <= the pass's (min2 / min1 over the fragments, the clear value on
 //    both sides).
 //  - vertex minima: per pixel, min_by_object of encode_near(z + kVertexSlack) over the window
-//    vertices in it. A triangle has a fragment at the pixel holding its vertex, with zmin <= that
-//    value (detail::kVertexSlack, encode_near), so the vertex minimum over the objects other than o
-//    is >= the pass's there.
+//    vertices in it (those inside the clip cube). A triangle has a fragment at the pixel holding
+//    such a vertex, with zmin <= that value (detail::kVertexSlack, encode_near), so the vertex
+//    minimum over the objects other than o is >= the pass's there.
 //  - an item with hi < the coarse minimum over the other objects at every pixel of its box is NOT
 //    hit: each of its fragments has zmax <= hi < the pass's minimum there.
 //  - an item with a vertex whose zmax bound, encode_near(z - kVertexSlack), is >= the vertex minimum
@@ -916,10 +926,13 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
     pre_area.assign(2 * n_parts, 0);  // per part: pixels of its boxes; then per part: its triangles
     PrePart& m = pre[0];              // the merged records
 
-    // 1. Boxes and the coarse minima; window vertices, the vertex minima and the records. A vertex
-    // shared by several items of a run of one object and one vertex array is mapped and marked once
-    // per part (its pixel and zmax bound kept in vcache, stamped with the run's generation).
+    // 1. Window vertices, the vertex minima and the records; boxes and the coarse minima. A vertex
+    // shared by several items of a run of one object and one vertex array is checked, mapped and
+    // marked once per part (what was found kept in vcache, stamped with the run's generation); an
+    // item whose vertices are all inside the clip cube takes its boxes from their window positions
+    // (detail::WindowBoxer, list_bounds' own step), any other from list_bounds.
     const detail::WindowMap window(params);
+    const detail::WindowBoxer boxer(params, format);
     detail::parallel_for(threads, n_parts, [&](std::size_t part) {
         PrePart& ps = pre[part];
         ps.c1.assign(pixels, clear);
@@ -940,64 +953,98 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
                     if (next.indices[k] < next.vertices.size()) __builtin_prefetch(next.vertices.data() + next.indices[k]);
             }
             const std::uint32_t obj = items[i].object;
+            const MeshViewD& mesh = items[i].mesh;
             BoxBound* bx = boxes.data() + box_first[i];
             std::uint32_t nbox = 0;
             std::uint64_t item_area = 0;
-            const detail::ListBounds b = detail::list_bounds(
-                params, items[i].mesh, format, [&](int x0, int y0, int x1, int y1, std::uint32_t lo, std::uint32_t hi) {
-                    bx[nbox++] = {static_cast<std::int16_t>(x0), static_cast<std::int16_t>(y0),
-                                  static_cast<std::int16_t>(x1), static_cast<std::int16_t>(y1), lo, hi};
-                    item_area += static_cast<std::uint64_t>(x1 - x0 + 1) * static_cast<std::uint64_t>(y1 - y0 + 1);
-                    for (int py = y0; py <= y1; ++py)
-                        for (int px = x0; px <= x1; ++px)
-                            min_by_object(ps.c1.data(), ps.co.data(), ps.c2.data(),
-                                          static_cast<std::size_t>(py) * w + static_cast<std::size_t>(px), obj, lo);
-                });
-            if (!b.ok) {
-                pre_failed[part] = 1;
-                return;
+            const auto add_box = [&](int x0, int y0, int x1, int y1, std::uint32_t lo, std::uint32_t hi) {
+                bx[nbox++] = {static_cast<std::int16_t>(x0), static_cast<std::int16_t>(y0),
+                              static_cast<std::int16_t>(x1), static_cast<std::int16_t>(y1), lo, hi};
+                item_area += static_cast<std::uint64_t>(x1 - x0 + 1) * static_cast<std::uint64_t>(y1 - y0 + 1);
+                for (int py = y0; py <= y1; ++py)
+                    for (int px = x0; px <= x1; ++px)
+                        min_by_object(ps.c1.data(), ps.co.data(), ps.c2.data(),
+                                      static_cast<std::size_t>(py) * w + static_cast<std::size_t>(px), obj, lo);
+            };
+            if (mesh.vertices.data() != run_vertices || obj != run_object) {  // a new run: new stamps
+                run_vertices = mesh.vertices.data();
+                run_object = obj;
+                if (ps.vstamp.size() < mesh.vertices.size()) {
+                    ps.vstamp.resize(mesh.vertices.size(), 0);
+                    ps.vcache.resize(mesh.vertices.size());
+                }
+                if (++ps.gen == 0) {
+                    std::fill(ps.vstamp.begin(), ps.vstamp.end(), 0u);
+                    ps.gen = 1;
+                }
+            }
+            // Each index: its vertex checked and, inside the clip cube, mapped to the window (once
+            // per run); the item's window extremes; a record per vertex in the target.
+            const std::size_t nv = mesh.vertices.size();
+            VertexRec* rec = vrec.data() + rec_first[i];
+            std::uint32_t nrec = 0;
+            bool all_inside = true;
+            constexpr double kInf = __builtin_inf();
+            double x0 = kInf, x1 = -kInf, y0 = kInf, y1 = -kInf, z0 = kInf, z1 = -kInf;
+            for (const std::uint32_t v : mesh.indices) {
+                if (v >= nv) {
+                    pre_failed[part] = 1;  // the front end finds and reports it
+                    return;
+                }
+                VertexMap& c = ps.vcache[v];
+                if (ps.vstamp[v] != ps.gen) {
+                    ps.vstamp[v] = ps.gen;
+                    const Double4& d = mesh.vertices[v];
+                    const double mag = std::max(std::max(std::fabs(d.x), std::fabs(d.y)), std::fabs(d.z));
+                    c.state = d.w != 1.0 || !(mag <= kMaxExactBoundsCoordinate) ? VertexMap::kBad
+                              : mag <= 1.0                                   ? VertexMap::kInside
+                                                                             : VertexMap::kBeyond;
+                    if (c.state == VertexMap::kInside) {
+                        c.win = window(d);
+                        c.pixel = kNoObject;  // outside the target: no fragment to name
+                        if (c.win.x >= 0.0 && c.win.x < static_cast<double>(width) && c.win.y >= 0.0 &&
+                            c.win.y < static_cast<double>(height)) {
+                            c.pixel = static_cast<std::uint32_t>(static_cast<std::size_t>(c.win.y) * w +
+                                                                 static_cast<std::size_t>(c.win.x));
+                            // encode_near bounds quantize_down from above and quantize_up from below.
+                            c.zmax = detail::encode_near(c.win.z - detail::kVertexSlack, format);
+                            min_by_object(ps.v1.data(), ps.vo.data(), ps.v2.data(), c.pixel, obj,
+                                          detail::encode_near(c.win.z + detail::kVertexSlack, format));
+                        }
+                    }
+                }
+                if (c.state == VertexMap::kBad) {
+                    pre_failed[part] = 1;
+                    return;
+                }
+                if (c.state == VertexMap::kBeyond) {
+                    all_inside = false;
+                    continue;
+                }
+                x0 = std::min(x0, c.win.x), x1 = std::max(x1, c.win.x);
+                y0 = std::min(y0, c.win.y), y1 = std::max(y1, c.win.y);
+                z0 = std::min(z0, c.win.z), z1 = std::max(z1, c.win.z);
+                if (c.pixel != kNoObject) rec[nrec++] = {c.pixel, c.zmax};
+            }
+            const std::size_t n_idx = mesh.indices.size();
+            if (!all_inside) {
+                (void)detail::list_bounds(params, mesh, format, add_box);  // (may be clipped: bounds_reach's boxes)
+            } else if (n_idx > 0 && !boxer(x0, x1, y0, y1, z0, z1, n_idx > 3 ? detail::kReachSpread * (n_idx / 3) : 0,
+                                          add_box)) {
+                for (std::size_t k = 0; k < n_idx; k += 3) {  // scattered: a box per triangle
+                    const detail::BoundsVertex& a = ps.vcache[mesh.indices[k]].win;
+                    const detail::BoundsVertex& b = ps.vcache[mesh.indices[k + 1]].win;
+                    const detail::BoundsVertex& cc = ps.vcache[mesh.indices[k + 2]].win;
+                    boxer(std::min(std::min(a.x, b.x), cc.x), std::max(std::max(a.x, b.x), cc.x),
+                          std::min(std::min(a.y, b.y), cc.y), std::max(std::max(a.y, b.y), cc.y),
+                          std::min(std::min(a.z, b.z), cc.z), std::max(std::max(a.z, b.z), cc.z), 0, add_box);
+                }
             }
             box_count[i] = nbox;
             verdict[i] = kOpen;
-            if (nbox > 0 && b.inside) {  // (a clipped item's box, the whole target, says nothing of its size)
+            if (nbox > 0 && all_inside) {  // (a clipped item's box, the whole target, says nothing of its size)
                 box_area += item_area;
-                triangles += items[i].mesh.indices.size() / 3;
-            }
-            std::uint32_t nrec = 0;
-            if (b.inside) {  // its window vertices: the vertex minima and its records
-                const MeshViewD& mesh = items[i].mesh;
-                if (mesh.vertices.data() != run_vertices || obj != run_object) {  // a new run: new stamps
-                    run_vertices = mesh.vertices.data();
-                    run_object = obj;
-                    if (ps.vstamp.size() < mesh.vertices.size()) {
-                        ps.vstamp.resize(mesh.vertices.size(), 0);
-                        ps.vcache.resize(mesh.vertices.size());
-                    }
-                    if (++ps.gen == 0) {
-                        std::fill(ps.vstamp.begin(), ps.vstamp.end(), 0u);
-                        ps.gen = 1;
-                    }
-                }
-                VertexRec* rec = vrec.data() + rec_first[i];
-                for (const std::uint32_t v : mesh.indices) {
-                    VertexRec& c = ps.vcache[v];
-                    if (ps.vstamp[v] != ps.gen) {
-                        ps.vstamp[v] = ps.gen;
-                        const detail::BoundsVertex wv = window(mesh.vertices[v]);
-                        if (!(wv.x >= 0.0 && wv.x < static_cast<double>(width) && wv.y >= 0.0 &&
-                              wv.y < static_cast<double>(height))) {
-                            c.pixel = kNoObject;  // outside the target: no fragment to name
-                            continue;
-                        }
-                        c.pixel = static_cast<std::uint32_t>(static_cast<std::size_t>(wv.y) * w +
-                                                             static_cast<std::size_t>(wv.x));
-                        // encode_near bounds quantize_down from above and quantize_up from below.
-                        c.zmax = detail::encode_near(wv.z - detail::kVertexSlack, format);
-                        min_by_object(ps.v1.data(), ps.vo.data(), ps.v2.data(), c.pixel, obj,
-                                      detail::encode_near(wv.z + detail::kVertexSlack, format));
-                    }
-                    if (c.pixel != kNoObject) rec[nrec++] = c;
-                }
+                triangles += n_idx / 3;
             }
             rec_count[i] = nrec;
         }

@@ -434,10 +434,10 @@ TEST_CASE("The fused visibility pass: an item of scattered triangles reaches eac
 // some are flat at one shared depth (ties between objects), some reach the far plane, some leave
 // the clip volume (clipped: bounds_reach's boxes), some have their vertices on pixel borders
 // (snap_x, snap_y: a pixel's width in clip units; 0: none), and some come in touching pairs: the
-// second patch starts at the first one's far edge, at the same positions and depths (or a hair
-// behind), and goes on behind (contact, where the pre-pass's bounds are tightest); all_pairs: every
-// patch is such a pair.
-// `size`: a patch's side in clip units (2 = the target).
+// second patch starts at the first one's far edge, at the same positions and depths (or up to a
+// few quantization steps behind), and goes on behind (contact, where the pre-pass's bounds are
+// tightest); all_pairs: every patch is such a pair. `size`: a patch's side in clip units (2 = the
+// target).
 Scene patch_scene(test::Rng& rng, int objects, double size, bool clipped = true, double snap_x = 0.0,
                   double snap_y = 0.0, bool all_pairs = false) {
     Scene s;
@@ -486,9 +486,11 @@ Scene patch_scene(test::Rng& rng, int objects, double size, bool clipped = true,
         if (!pair) continue;
         // The partner: the patch reflected across its far (last) row, in y and in depth, so it
         // shares that row exactly and lies behind it everywhere else; half the partners start up to
-        // one D16 step (2 / 65535 in clip z) further back, so that the two straddle a quantization
-        // step by a hair (where the pre-pass's cheap encodings must still bound the exact ones).
-        const double gap = rng.coin() ? 0.0 : rng.uniform(0.0, 2.0 / 65535.0);
+        // three D16 or D24 steps (2 / 65535 or 2 / 16777215 in clip z) further back, so that the
+        // two lie a few quantization steps apart or straddle one by a hair (where the pre-pass's
+        // cheap encodings must still bound the exact ones).
+        const double step = rng.coin() ? 2.0 / 65535.0 : 2.0 / 16777215.0;
+        const double gap = rng.coin() ? 0.0 : rng.uniform(0.0, 3.0) * step;
         std::vector<Double4> mirror(grid.size());
         for (int j = 0; j <= gy; ++j)
             for (int i = 0; i <= gx; ++i) {
@@ -554,12 +556,12 @@ TEST_CASE("The settling pre-pass gives the recorded answers, settling items and 
     CHECK(sum.triangles_left_out > 20000);
 }
 
-TEST_CASE("The settling pre-pass: objects in contact, a hair apart across a quantization step, give the recorded answers") {
+TEST_CASE("The settling pre-pass: objects in contact, a few quantization steps apart, give the recorded answers") {
     // Pairs of patches alone in the view that touch along an edge (the second starts at the first
-    // one's far edge, at the same depth or up to one D16 step behind: patch_scene's pairs). There
-    // the exact pass finds the front one hit or not by a single quantization step, and the
-    // pre-pass's cheap encodings (encode_below_down, encode_above_up, encode_near) must still bound
-    // the exact ones: a bound one step too tight settles the front item as not hit.
+    // one's far edge, at the same depth or up to three D16 or D24 steps behind: patch_scene's
+    // pairs). There the exact pass finds the front one hit or not by a quantization step or two,
+    // and the pre-pass's cheap encodings (encode_below_down, encode_above_up, encode_near) must still
+    // bound the exact ones: a bound two steps off settles an item the wrong way.
     test::Rng rng(20261131);
     const DepthFormat formats[] = {DepthFormat::D16, DepthFormat::D24, DepthFormat::D32F};
     int hit = 0, visible = 0;
