@@ -846,8 +846,9 @@ void VisibilityPass::State::raster_part(std::span<const VisibilityItem> items, c
 //    above z: every tested fragment gets the answer it gets in the full pass.
 // So the answers are the full pass's bit for bit (the settled items take their verdicts), for any
 // thread count: every step is a function of the input (the parts' minima merge exactly, as the split
-// pass's do). The alone pre-pass is not run then: an item it would spare is settled here (no other
-// object's box reaches its pixels, so hi < the clear value settles it) and left out.
+// pass's do). The alone pre-pass is not run then: an item it would spare is settled here too (no
+// other object's box reaches its pixels, so the coarse minimum there is the clear value, above its
+// hi unless it reaches the far plane within a step of the encoding) and left out.
 namespace {
 // max_by_object: min_by_object's twin for maxima (0 = none): m1 the largest value with its object
 // o1, m2 the largest of any object other than o1.
