@@ -328,31 +328,24 @@ inline std::uint32_t encode_above_up(double z, DepthFormat format) {
     return c < top ? c + 1 : top;
 }
 
-// The bounds of a list of triangles from their vertices alone, without setting them up: for the
-// fused visibility pass's settling pre-pass (visibility.cpp, State::presettle). It calls
-// box(x0, y0, x1, y1, lo, hi) (inclusive pixels inside the target) for boxes such that every
-// BoundsTri record that setup_bounds_triangle makes of the triangles (indices[3k], indices[3k + 1],
-// indices[3k + 2]) of `mesh` lies in one of them with the encoded zmin of each of its fragments
-// >= lo and its zmax <= hi (the draw's quantization is quantize_down(zlo - margin_z) and
-// quantize_up(zhi + margin_z); lo and hi are the cheap bounds of those, encode_below_down and
-// encode_above_up): the list's box, or, when that is more than kReachSpread pixels per triangle
-// (scattered triangles), one box per triangle with its own depth bounds. With `inside` (every
-// |coordinate| <= 1) no triangle is clipped (WindowMap below gives its window vertices).
+// Bounds of triangles from their vertices alone, without setting them up, for the fused visibility
+// pass's settling pre-pass (visibility.cpp, State::presettle): for triangles whose every
+// |coordinate| is <= 1, given the extremes of their window positions (WindowMap below), box(x0, y0,
+// x1, y1, lo, hi) (inclusive pixels inside the target; none when the box is outside) such that
+// every BoundsTri record that setup_bounds_triangle makes of them lies in the box, with the encoded
+// zmin of each of its fragments >= lo and its zmax <= hi (the draw's quantization is
+// quantize_down(zlo - margin_z) and quantize_up(zhi + margin_z); lo and hi are the cheap bounds of
+// those, encode_below_down and encode_above_up). With spread_limit > 0 it calls nothing and returns
+// false when the box holds more pixels than that (the caller then boxes each triangle).
 // Why: with every |coordinate| <= 1 < lim setup takes the unclipped path with M = 1, so each
 // triangle's margins are kPixelMargin + kClipMarginRel * max(w / 2, h / 2) and kDepthMargin +
 // kClipMarginRel, and its box is grown_box of its window extremes. The window map x * (w / 2) +
-// (x0 + w / 2) is monotone in x (so is its rounding), so the extremes of more vertices map to
-// extremes at least as far out, and grown_box is monotone too. Every (zlo, zhi) a path reports lies
-// in the triangle's vertex depth range widened by 2^-40 max|z| + 2^-1000 (bounds_depth_range, which
-// widens only the general path; the others stay inside the vertex range), and subtraction, addition
-// and both quantizations are monotone. A list with a larger coordinate may be clipped: bounds_reach's
-// boxes (pixels; they hold every record's box) with the widest encoded range. ok = false when an index or
-// vertex fails the input checks (the front end reports it; box may have been called).
-// list_bounds' box step for triangles inside the clip volume (every |coordinate| <= 1: M = 1), from
-// their window extremes (the window map is monotone, so the extremes of the window positions are
-// the map of the extremes): box(x0, y0, x1, y1, lo, hi) with the grown box cut to the target (none
-// when it is outside), lo and hi as list_bounds says. With spread_limit > 0 it calls nothing and
-// returns false when the box holds more pixels than that.
+// (x0 + w / 2) is monotone in x (so is its rounding), so the extremes of more vertices are at least
+// as far out, and grown_box is monotone too. Every (zlo, zhi) a path reports lies in the triangle's
+// vertex depth range widened by 2^-40 max|z| + 2^-1000 (bounds_depth_range, which widens only the
+// general path; the others stay inside the vertex range), and subtraction, addition and both
+// quantizations are monotone. (Triangles with a larger coordinate may be clipped: the pre-pass
+// takes bounds_reach's boxes for them, with the widest encoded range.)
 struct WindowBoxer {
     int width, height;
     double m, mz;
@@ -380,61 +373,6 @@ struct WindowBoxer {
         return true;
     }
 };
-
-struct ListBounds {
-    bool ok = true;
-    bool inside = false;
-};
-template <class Box>
-inline ListBounds list_bounds(const FrontEndParams& params, const MeshViewD& mesh, DepthFormat format, Box&& box) {
-    ListBounds r;
-    const std::size_t nv = mesh.vertices.size();
-    const std::size_t n = mesh.indices.size() - mesh.indices.size() % 3;
-    if (n == 0) return r;
-    constexpr double kInf = __builtin_inf();
-    double absmax = 0.0, cx0 = kInf, cx1 = -kInf, cy0 = kInf, cy1 = -kInf, cz0 = kInf, cz1 = -kInf;
-    for (std::size_t k = 0; k < n; ++k) {
-        const std::uint32_t i = mesh.indices[k];
-        if (i >= nv) {
-            r.ok = false;
-            return r;
-        }
-        const Double4& v = mesh.vertices[i];
-        const double m = std::max(std::max(std::fabs(v.x), std::fabs(v.y)), std::fabs(v.z));
-        if (v.w != 1.0 || !(m <= kMaxExactBoundsCoordinate)) {
-            r.ok = false;
-            return r;
-        }
-        absmax = m > absmax ? m : absmax;
-        cx0 = std::min(cx0, v.x), cx1 = std::max(cx1, v.x);
-        cy0 = std::min(cy0, v.y), cy1 = std::max(cy1, v.y);
-        cz0 = std::min(cz0, v.z), cz1 = std::max(cz1, v.z);
-    }
-    if (!(absmax <= 1.0)) {  // may be clipped: bounds_reach's boxes, with the widest depth range
-        (void)bounds_reach(params, mesh, format, 0,
-                           [&](int x0, int y0, int x1, int y1) { box(x0, y0, x1, y1, 0u, 0xffffffffu); });
-        return r;
-    }
-    const Viewport& vp = params.viewport;
-    const double hw = static_cast<double>(vp.width) * 0.5;
-    const double hh = static_cast<double>(vp.height) * 0.5;
-    const double tx = static_cast<double>(vp.x) + hw;
-    const double ty = static_cast<double>(vp.y) + hh;
-    r.inside = true;
-    const WindowBoxer boxer(params, format);
-    if (!boxer(cx0 * hw + tx, cx1 * hw + tx, cy0 * hh + ty, cy1 * hh + ty, cz0 * 0.5 + 0.5, cz1 * 0.5 + 0.5,
-               n > 3 ? kReachSpread * (n / 3) : 0, box)) {
-        for (std::size_t k = 0; k < n; k += 3) {  // scattered: a box per triangle
-            const Double4& a = mesh.vertices[mesh.indices[k]];
-            const Double4& b = mesh.vertices[mesh.indices[k + 1]];
-            const Double4& c = mesh.vertices[mesh.indices[k + 2]];
-            boxer(std::min(std::min(a.x, b.x), c.x) * hw + tx, std::max(std::max(a.x, b.x), c.x) * hw + tx,
-                  std::min(std::min(a.y, b.y), c.y) * hh + ty, std::max(std::max(a.y, b.y), c.y) * hh + ty,
-                  std::min(std::min(a.z, b.z), c.z) * 0.5 + 0.5, std::max(std::max(a.z, b.z), c.z) * 0.5 + 0.5, 0, box);
-        }
-    }
-    return r;
-}
 
 // The window position of a vertex with every |coordinate| <= 1: the very values that
 // setup_bounds_triangle computes for it, clipped or not (the same operations on the same inputs;

@@ -822,9 +822,9 @@ void VisibilityPass::State::raster_part(std::span<const VisibilityItem> items, c
 // The settling pre-pass (issue #16, "model only what a scene needs"). In R-CULLIDE's 32^2 views
 // most items' answers are already certain from bounds that cost a fraction of a setup, and most
 // items cannot change the answer of an item that is not. From the vertices alone
-// (detail::list_bounds and WindowBoxer: an item's pixel box, or a box per triangle, with [lo, hi]
-// holding every zmin and zmax of its fragments there; detail::WindowMap: the window position of each
-// vertex inside the clip cube, setup's very values):
+// (detail::WindowBoxer, or bounds_reach for items that may be clipped: an item's pixel box, or a box
+// per triangle, with [lo, hi] holding every zmin and zmax of its fragments there;
+// detail::WindowMap: the window position of each vertex inside the clip cube, setup's very values):
 //  - coarse minima: per pixel, min_by_object of lo over every item whose box holds the pixel. An
 //    item's fragments lie in its box with zmin >= lo, so at every pixel the coarse minimum over the
 //    objects other than o is <= the pass's (min2 / min1 over the fragments, the clear value on
@@ -931,7 +931,7 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
     // shared by several items of a run of one object and one vertex array is checked, mapped and
     // marked once per part (what was found kept in vcache, stamped with the run's generation); an
     // item whose vertices are all inside the clip cube takes its boxes from their window positions
-    // (detail::WindowBoxer, list_bounds' own step), any other from list_bounds.
+    // (detail::WindowBoxer), any other bounds_reach's boxes with the widest depth range.
     const detail::WindowMap window(params);
     const detail::WindowBoxer boxer(params, format);
     detail::parallel_for(threads, n_parts, [&](std::size_t part) {
@@ -1029,7 +1029,11 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
             }
             const std::size_t n_idx = mesh.indices.size();
             if (!all_inside) {
-                (void)detail::list_bounds(params, mesh, format, add_box);  // (may be clipped: bounds_reach's boxes)
+                // May be clipped: bounds_reach's boxes (pixels on one-tile targets: shift 0) hold
+                // every record's box; any depth.
+                (void)detail::bounds_reach(params, mesh, format, 0, [&](int bx0, int by0, int bx1, int by1) {
+                    add_box(bx0, by0, bx1, by1, 0u, 0xffffffffu);
+                });
             } else if (n_idx > 0 && !boxer(x0, x1, y0, y1, z0, z1, n_idx > 3 ? detail::kReachSpread * (n_idx / 3) : 0,
                                           add_box)) {
                 for (std::size_t k = 0; k < n_idx; k += 3) {  // scattered: a box per triangle
