@@ -7,6 +7,7 @@
 #include <bit>
 #include <atomic>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
@@ -61,8 +62,9 @@ constexpr std::uint64_t kSplitRunsPerThread = 4;
 // spared at least kAloneMinSpared, and otherwise after 2, 4, ... up to kAloneProbe calls without it
 // (doubling after each run that did not pay, quadrupling after one that spared under half the bar),
 // to notice when the scene changes (a probe every 8th call cost those scenes 1-6%, every 32nd
-// under 1%). The settling pre-pass keeps such a history too (kSettleMinSpared). Calls of fewer than kAloneMinTriangles
-// triangles always run it (cheap either way). Only the work depends on it, never an answer.
+// under 1%). The settling pre-pass keeps such a history too (kSettleMinSpared). Calls of fewer
+// than kAloneMinTriangles triangles always run it (cheap either way). Only the work depends on it,
+// never an answer.
 constexpr std::uint64_t kAloneMinTriangles = 1024;
 constexpr double kAloneMinSpared = 0.3;
 constexpr unsigned kAloneProbe = 32;
@@ -206,39 +208,50 @@ inline bool occ_alone(const detail::CellGrid& g, const std::uint8_t* state, cons
     return r.single && r.zq_hi < clear && occ_one(g, state, r.x0, r.y0, r.x1, r.y1);
 }
 
-// The per-pixel record the pass keeps (see test_fragments): m1 the smallest value with its object o1,
-// m2 the smallest value of any object other than o1 (each starts at the clear value).
-inline void min_by_object(std::uint32_t* m1, std::uint32_t* o1, std::uint32_t* m2, std::size_t p, std::uint32_t obj,
-                          std::uint32_t z) {
+// The per-pixel record the pass keeps (see test_fragments), for an order `first` (std::less: the
+// smallest values; std::greater: the largest): m1 the first value with its object o1, m2 the first
+// value of any object other than o1.
+template <class T, class First>
+inline void by_object(T* m1, std::uint32_t* o1, T* m2, std::size_t p, std::uint32_t obj, T z, First first) {
     if (obj == o1[p]) {
-        m1[p] = std::min(m1[p], z);
-    } else if (z < m1[p]) {
+        m1[p] = std::min(m1[p], z, first);
+    } else if (first(z, m1[p])) {
         m2[p] = m1[p];
         m1[p] = z;
         o1[p] = obj;
     } else {
-        m2[p] = std::min(m2[p], z);
+        m2[p] = std::min(m2[p], z, first);
     }
+}
+// Merges record b into record a, pixel by pixel: a then holds the record of both sets of values (the
+// first m1 wins with its object; m2 becomes the first over the objects other than that one, which
+// from the other record is its m2 if it holds the same object and its m1 otherwise).
+template <class T, class First>
+void merge_by_object(T* a1, std::uint32_t* ao, T* a2, const T* b1, const std::uint32_t* bo, const T* b2,
+                     std::size_t pixels, First first) {
+    for (std::size_t p = 0; p < pixels; ++p) {
+        if (first(b1[p], a1[p])) {
+            a2[p] = std::min(b2[p], ao[p] == bo[p] ? a2[p] : a1[p], first);
+            a1[p] = b1[p];
+            ao[p] = bo[p];
+        } else {
+            a2[p] = std::min(a2[p], bo[p] == ao[p] ? b2[p] : b1[p], first);
+        }
+    }
+}
+// The minima the pass keeps (each record starts at the clear value).
+inline void min_by_object(std::uint32_t* m1, std::uint32_t* o1, std::uint32_t* m2, std::size_t p, std::uint32_t obj,
+                          std::uint32_t z) {
+    by_object(m1, o1, m2, p, obj, z, std::less<std::uint32_t>());
+}
+void merge_min_by_object(std::uint32_t* a1, std::uint32_t* ao, std::uint32_t* a2, const std::uint32_t* b1,
+                         const std::uint32_t* bo, const std::uint32_t* b2, std::size_t pixels) {
+    merge_by_object(a1, ao, a2, b1, bo, b2, pixels, std::less<std::uint32_t>());
 }
 // The smallest value at pixel p over the objects other than obj (with the clear value).
 inline std::uint32_t other_min(const std::uint32_t* m1, const std::uint32_t* o1, const std::uint32_t* m2, std::size_t p,
                                std::uint32_t obj) {
     return o1[p] == obj ? m2[p] : m1[p];
-}
-// Merges record b into record a, pixel by pixel: a then holds the record of both sets of values (the
-// smaller m1 wins with its object; m2 becomes the minimum over the objects other than that one,
-// which from the other record is its m2 if it holds the same object and its m1 otherwise).
-void merge_min_by_object(std::uint32_t* a1, std::uint32_t* ao, std::uint32_t* a2, const std::uint32_t* b1,
-                         const std::uint32_t* bo, const std::uint32_t* b2, std::size_t pixels) {
-    for (std::size_t p = 0; p < pixels; ++p) {
-        if (b1[p] < a1[p]) {
-            a2[p] = std::min(b2[p], ao[p] == bo[p] ? a2[p] : a1[p]);
-            a1[p] = b1[p];
-            ao[p] = bo[p];
-        } else {
-            a2[p] = std::min(a2[p], bo[p] == ao[p] ? b2[p] : b1[p]);
-        }
-    }
 }
 
 // When a pre-pass that spares work runs (the items-alone pre-pass: kAloneMinSpared, kAloneProbe
@@ -407,7 +420,6 @@ struct VisibilityPass::State {
     std::vector<std::uint8_t> drawn;              // per item: in `reduced`
     std::vector<VisibilityItem> reduced;          // the items drawn, in order
     std::vector<std::uint32_t> reduced_at;        // per item: its index in `reduced` (if drawn)
-    std::uint64_t last_settled = 0;
     PresettleStats settled;  // of the last run()
     bool presettle_on = true;
     // 0: not applied (input that fails a check, or large triangles: the caller goes on as without
@@ -849,32 +861,6 @@ void VisibilityPass::State::raster_part(std::span<const VisibilityItem> items, c
 // pass's do). The alone pre-pass is not run then: an item it would spare is settled here too (no
 // other object's box reaches its pixels, so the coarse minimum there is the clear value, above its
 // hi unless it reaches the far plane within a step of the encoding) and left out.
-namespace {
-// max_by_object: min_by_object's twin for maxima (0 = none): m1 the largest value with its object
-// o1, m2 the largest of any object other than o1.
-inline void max_by_object(std::uint64_t* m1, std::uint32_t* o1, std::uint64_t* m2, std::size_t p, std::uint32_t obj,
-                          std::uint64_t z) {
-    const std::uint64_t a = m1[p], b = m2[p];
-    const std::uint32_t ao = o1[p];
-    const bool same = obj == ao;
-    const bool above = z > a;
-    m1[p] = above ? z : a;
-    o1[p] = !same && above ? obj : ao;
-    m2[p] = same ? b : above ? a : std::max(b, z);
-}
-void merge_max_by_object(std::uint64_t* a1, std::uint32_t* ao, std::uint64_t* a2, const std::uint64_t* b1,
-                         const std::uint32_t* bo, const std::uint64_t* b2, std::size_t pixels) {
-    for (std::size_t p = 0; p < pixels; ++p) {
-        if (b1[p] > a1[p]) {
-            a2[p] = std::max(b2[p], ao[p] == bo[p] ? a2[p] : a1[p]);
-            a1[p] = b1[p];
-            ao[p] = bo[p];
-        } else {
-            a2[p] = std::max(a2[p], bo[p] == ao[p] ? b2[p] : b1[p]);
-        }
-    }
-}
-}  // namespace
 
 int VisibilityPass::State::presettle(int width, int height, DepthFormat format, std::span<const VisibilityItem> items,
                                      int threads) {
@@ -1097,14 +1083,15 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
                 continue;
             }
             for_pixels(i, [&](const BoxBound& t, std::size_t p) {
-                max_by_object(ps.u1.data(), ps.uo.data(), ps.u2.data(), p, obj, std::uint64_t{t.hi} + 1);
+                by_object(ps.u1.data(), ps.uo.data(), ps.u2.data(), p, obj, std::uint64_t{t.hi} + 1,
+                          std::greater<std::uint64_t>());
                 return true;
             });
         }
     });
     for (std::size_t part = 1; part < n_parts; ++part)
-        merge_max_by_object(m.u1.data(), m.uo.data(), m.u2.data(), pre[part].u1.data(), pre[part].uo.data(),
-                            pre[part].u2.data(), pixels);
+        merge_by_object(m.u1.data(), m.uo.data(), m.u2.data(), pre[part].u1.data(), pre[part].uo.data(),
+                        pre[part].u2.data(), pixels, std::greater<std::uint64_t>());
 
     // 3. The items drawn: the open ones, and those whose lo an open item of another object may meet.
     detail::parallel_for(threads, n_parts, [&](std::size_t part) {
@@ -1126,15 +1113,14 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
         tested.push_back(verdict[i] == kOpen ? 1 : 0);
         drawn_indices += items[i].mesh.indices.size();
     }
-    last_settled = (total - drawn_indices) / 3;
     settled = PresettleStats{};
     settled.ran = true;
+    settled.triangles_left_out = (total - drawn_indices) / 3;
     for (std::size_t i = 0; i < n; ++i) {
         settled.items_hit += verdict[i] == kHit;
         settled.items_not_hit += verdict[i] == kNotHit;
         settled.items_open += verdict[i] == kOpen;
     }
-    settled.triangles_left_out = last_settled;
     return reduced.empty() ? 2 : 1;
 }
 
@@ -1161,16 +1147,15 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
     const int one_side = tile_side(width, height);
     const bool one_tile = one_side >= width && one_side >= height;
     // On one-tile targets the settling pre-pass first: the items it settles take their verdicts,
-    // and the pass below runs on `work`, the same items with only the triangles that can change an
-    // open item's answer (State::presettle).
-    s.last_settled = 0;
+    // and the pass below runs on `reduced`, the items that can change an open item's answer, in
+    // order (State::presettle).
     s.settled = PresettleStats{};
     int presettled = 0;
     const PayGuard::Call whole = PayGuard::call_of(items);
     if (one_tile && s.presettle_on) {
         if (s.settle_guard.wanted(whole)) {
             presettled = s.presettle(width, height, format, items, threads);
-            s.settle_guard.record(whole, s.last_settled);
+            s.settle_guard.record(whole, s.settled.triangles_left_out);
         }
     }
     const std::span<const VisibilityItem> all_items = items;
@@ -1183,9 +1168,8 @@ Result<std::vector<std::uint8_t>> VisibilityPass::run(int width, int height, Dep
                                                   : 0;
         return out;
     };
-    if (presettled == 2) {
+    if (presettled == 2) {  // (answer() reads no hit[]: every item has its verdict)
         s.guard.last_spared = 0;
-        s.hit.assign(items.size(), 0);
         return answer();
     }
     if (presettled == 1) items = s.reduced;
