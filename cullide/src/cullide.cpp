@@ -234,6 +234,31 @@ struct Pruned {
 // Both passes of one exact-bounds view as the device's visibility pass (query_device.h); prunes
 // the fully visible items. The fused and the recorded form give the same answers
 // (tests/cullide/fused_visibility_test.cpp compares the two).
+// The queries and triangles of the two passes record_pass would record for `order` (the fused
+// pass, and a view answered without passes, report what they replace): each live item is queried in
+// both passes and written in both except after each pass's last object (order.back() forward,
+// order.front() backward), so with L live items of T triangles in all, 2 L queries and
+// 4 T - T(back) - T(front) triangles. `each` sees every live item with its position in `order`.
+template <class Each>
+void count_passes(std::vector<ObjectGeometry>& g, const std::vector<std::size_t>& order, ViewStats& vs, Each&& each) {
+    std::uint64_t items = 0, triangles = 0, first_triangles = 0, last_triangles = 0;
+    for (std::size_t k = 0; k < order.size(); ++k) {
+        ObjectGeometry& og = g[order[k]];
+        std::uint64_t object_triangles = 0;
+        for (Item& it : og.items) {
+            if (!it.live) continue;
+            each(og, it, k);
+            ++items;
+            object_triangles += it.index_count / 3;
+        }
+        triangles += object_triangles;
+        if (k == 0) first_triangles = object_triangles;
+        if (k + 1 == order.size()) last_triangles = object_triangles;
+    }
+    vs.queries += 2 * items;
+    vs.triangles_rasterized += 4 * triangles - last_triangles - first_triangles;
+}
+
 Result<Pruned> visibility_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_t>& order,
                                const CullideOptions& o, ViewSize size, QueryDevice& device, ViewStats& vs) {
     // Kept per thread (capacity only), as the views of a frame follow one another.
@@ -241,28 +266,12 @@ Result<Pruned> visibility_view(std::vector<ObjectGeometry>& g, const std::vector
     thread_local std::vector<Item*> refs;
     items.clear();
     refs.clear();
-    // The queries and triangles of the two passes record_pass would record for `order` (the fused
-    // pass reports what it replaces): each live item is queried in both passes and written in both
-    // except after each pass's last object (order.back() forward, order.front() backward), so with
-    // L live items of T triangles in all, 2 L queries and 4 T - T(back) - T(front) triangles.
-    std::uint64_t triangles = 0, first_triangles = 0, last_triangles = 0;
-    for (std::size_t k = 0; k < order.size(); ++k) {
-        ObjectGeometry& og = g[order[k]];
-        std::uint64_t object_triangles = 0;
-        for (Item& it : og.items) {
-            if (!it.live) continue;
-            items.push_back({raster::MeshViewD{og.clip_d, std::span<const std::uint32_t>(og.indices)
-                                                              .subspan(it.first_index, it.index_count)},
-                             static_cast<std::uint32_t>(k)});
-            refs.push_back(&it);
-            object_triangles += it.index_count / 3;
-        }
-        triangles += object_triangles;
-        if (k == 0) first_triangles = object_triangles;
-        if (k + 1 == order.size()) last_triangles = object_triangles;
-    }
-    vs.queries += 2 * items.size();
-    vs.triangles_rasterized += 4 * triangles - last_triangles - first_triangles;
+    count_passes(g, order, vs, [&](ObjectGeometry& og, Item& it, std::size_t k) {
+        items.push_back({raster::MeshViewD{og.clip_d, std::span<const std::uint32_t>(og.indices)
+                                                          .subspan(it.first_index, it.index_count)},
+                         static_cast<std::uint32_t>(k)});
+        refs.push_back(&it);
+    });
     Result<std::vector<std::uint8_t>> r = o.fused_visibility
                                               ? device.visibility_pass(size, o.depth_format, items)
                                               : device.recorded_visibility_pass(size, o.depth_format, items);
@@ -431,6 +440,51 @@ Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_
     }
 }
 
+// Whether every live item's closed box overlaps (or touches) the closed box of a live item of
+// another object: then no exact-bounds view of the stage can prune any of them. Where the boxes of
+// items A and B (objects a != b) share a point p, the view's transform, monotone along each axis,
+// keeps them sharing a point in clip space; a pixel whose closed square holds p's window position
+// meets a face of each box on both sides of p along the view axis, and the exact-bounds mode
+// covers it with depth intervals rounded outward from the faces'. So there A's largest zmax is >=
+// p's depth >= B's smallest zmin, and one of the two passes, the one that draws B before querying
+// A, finds A not fully visible there (and B likewise); both stay live, so the next view sees the
+// same pairs (induction over the views). Box items are also exactly their corners' box, so this is
+// used for the box stage (one item per object), where R-CULLIDE's views are then known to prune
+// nothing without running them (CullideOptions::box_stage has the same argument). Sweep and prune
+// along x over the items sorted by box.lo.x, stopping with false after kMaxOverlapChecks per item
+// (boxes piled along x: the views then run as before).
+bool all_boxes_overlapped(const std::vector<ObjectGeometry>& g) {
+    constexpr std::size_t kMaxOverlapChecks = 64;
+    struct Entry {
+        const Aabb* box;
+        std::uint32_t object;
+        std::uint8_t* seen;
+    };
+    std::vector<Entry> e;
+    for (std::size_t i = 0; i < g.size(); ++i)
+        for (const Item& it : g[i].items)
+            if (it.live) e.push_back({&it.box, static_cast<std::uint32_t>(i), nullptr});
+    if (e.size() < 2) return false;
+    for (const Entry& x : e)
+        if (!(x.box->lo.x <= x.box->hi.x && x.box->lo.y <= x.box->hi.y && x.box->lo.z <= x.box->hi.z))
+            return false;  // an empty box (an object without triangles) overlaps nothing
+    std::sort(e.begin(), e.end(), [](const Entry& a, const Entry& b) { return a.box->lo.x < b.box->lo.x; });
+    std::vector<std::uint8_t> seen(e.size(), 0);
+    std::size_t checks = 0;
+    for (std::size_t i = 0; i < e.size(); ++i) {
+        const Aabb& a = *e[i].box;
+        for (std::size_t j = i + 1; j < e.size() && e[j].box->lo.x <= a.hi.x; ++j) {
+            if (++checks > kMaxOverlapChecks * e.size()) return false;
+            const Aabb& b = *e[j].box;
+            if (e[j].object != e[i].object && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y && a.lo.z <= b.hi.z &&
+                b.lo.z <= a.hi.z)
+                seen[i] = seen[j] = 1;
+        }
+        if (!seen[i]) return false;  // every later box starts after a.hi.x or was checked
+    }
+    return true;
+}
+
 // Views along x, y, z in turn until three views in a row are unproductive (CullideOptions::min_prune;
 // with 0, three views that prune nothing: then the PCS, and so every further view, is unchanged) or
 // 3 * max_rounds views ran.
@@ -440,6 +494,11 @@ Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideO
         o.min_prune >= 0.0 ? o.min_prune : o.mode == VisibilityMode::ExactBounds ? kDefaultMinPruneExactBounds : 0.0;
     int quiet = 0;
     std::vector<std::size_t> order;
+    // Exact-bounds box views where every box overlaps another: answered without running them (each
+    // prunes nothing, all_boxes_overlapped); the statistics count the passes they stand for, as the
+    // fused pass's do (issue #16: 0.6-1 ms of a frame on tori and breaking, whose boxes all overlap).
+    const bool none_prunable = o.settle_box_views && o.mode == VisibilityMode::ExactBounds &&
+                               stage == CullStage::Boxes && all_boxes_overlapped(g);
     for (int view = 0; view < 3 * o.max_rounds && quiet < 3; ++view) {
         // One pass over the items: the objects with live items (order), the union of the live
         // items' boxes, and how many items and triangles are live.
@@ -463,14 +522,21 @@ Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideO
             return Status{};
         }
         const int axis = view % 3;
-        if (Status sv = prepare_view(g, order, stage, axis, bounds, o, size); !sv) return sv;
         ViewStats vs;
         vs.stage = stage;
         vs.axis = axis;
         vs.items_before = items_before;
-        Result<Pruned> pruned = o.mode == VisibilityMode::ExactBounds
-                                    ? visibility_view(g, order, o, size, device, vs)
-                                    : recorded_view(g, order, o, size, device, vs);
+        Result<Pruned> pruned = Pruned{};
+        if (none_prunable) {
+            // The view is still fitted, so that a scene whose extent overflows fails here as before.
+            if (Result<raster::OrthoView> v = make_view(axis, bounds, 0.0, size, o.depth_format); !v) return v.error();
+            count_passes(g, order, vs, [](ObjectGeometry&, Item&, std::size_t) {});
+            ++st.box_views_settled;
+        } else {
+            if (Status sv = prepare_view(g, order, stage, axis, bounds, o, size); !sv) return sv;
+            pruned = o.mode == VisibilityMode::ExactBounds ? visibility_view(g, order, o, size, device, vs)
+                                                           : recorded_view(g, order, o, size, device, vs);
+        }
         if (!pruned) return pruned.error();
         vs.items_after = vs.items_before - pruned.value().items;
         st.queries += vs.queries;

@@ -86,6 +86,12 @@ struct CullideOptions : VisibilityOptions {
     // nothing and process_frame turns it off for rcullide. false is always safe (the stage only
     // prunes): the later stages then start from every active object.
     bool box_stage = true;
+    // ExactBounds: when every live object's closed box overlaps another's before the box stage, its
+    // views are known to prune nothing (the argument above) and are answered without running them;
+    // the statistics still count the queries and triangles of the passes they stand for (as
+    // fused_visibility's do), so every figure is the same as with the views run. false runs them
+    // (tests compare the two).
+    bool settle_box_views = true;
 };
 
 // The shared figures (visibility.h: pcs_boxes, pcs_objects, pcs_subobjects are the PCS after each
@@ -93,6 +99,7 @@ struct CullideOptions : VisibilityOptions {
 struct CullideStats : VisibilityStats {
     std::uint64_t subobject_pairs = 0;  // sub-object pairs across objects holding a triangle pair
                                         // whose boxes overlap (a pair the exact stage tests)
+    std::uint64_t box_views_settled = 0;  // box views answered without running them (settle_box_views)
 };
 
 // Colliding triangle pairs found by CULLIDE among the objects listed in `active` (increasing
