@@ -374,6 +374,86 @@ TEST_CASE("a big object in many pair tasks (walked in spatial order) gives the s
     }
 }
 
+TEST_CASE("dense cells sorted once per slab by radix give the set sweep's pairs and counts") {
+    // Triangles a quarter of the scene across, so the sweep grid's cells hold hundreds of refs each
+    // and the slab's refs are radix-sorted before binning (exact_stage.cpp, sorted_refs). The lows
+    // span signs, -0.0 and 0.0, magnitudes from 2^-20 to 2^10 and many exact ties, so every byte of
+    // the ordered float key and the sign flip matter; with self pairs too (adjacency first).
+    std::uint64_t pairs = 0;
+    for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+        CAPTURE(seed);
+        const bool self = seed % 2 == 0;
+        test::Rng rng(seed + 3000);
+        std::vector<Mesh> scene(2);
+        const double scale = seed % 3 == 0 ? 0x1p-20 : seed % 3 == 1 ? 1.0 : 0x1p10;
+        for (Mesh& m : scene) {
+            for (std::uint32_t t = 0; t < 700; ++t) {
+                // Half on a coarse grid (ties, zero low bytes), half anywhere (every byte varies).
+                const bool on_grid = rng.coin();
+                const auto coord = [&](double lo, double hi) { return on_grid ? rng.grid(lo, hi, 8) : rng.uniform(lo, hi); };
+                const Vec3 c{coord(-4, 4), coord(-4, 4), coord(-4, 4)};
+                for (int k = 0; k < 3; ++k) {
+                    Vec3 p = c + Vec3{coord(-1, 1), coord(-1, 1), coord(-1, 1)};
+                    for (int a = 0; a < 3; ++a) p[a] = p[a] == 0.0 && rng.coin() ? -0.0 : p[a] * scale;
+                    m.positions.push_back(p);
+                }
+                if (self && t > 0 && rng.below(2) == 0)
+                    m.triangles.push_back({3 * t - 1, 3 * t, 3 * t + 1});  // shares a vertex with the previous
+                else
+                    m.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
+            }
+        }
+        cullide::ExactStats st;
+        auto got = cullide::exact_pairs(scene, {self, 2}, &st);
+        REQUIRE(got.ok());
+        std::vector<std::vector<std::uint32_t>> welded;
+        const cullide::detail::ExactStageResult want = set_sweep(scene, self, welded);
+        CHECK(got.value() == want.pairs);
+        CHECK(got.value() == test::brute_force_pairs(scene, self));
+        CHECK(st.candidate_triangles == want.stats.task_triangles);
+        CHECK(st.box_pairs == want.stats.tests);
+        CHECK(st.adjacent_skipped == want.stats.adjacent_skipped);
+        pairs += want.pairs.size();
+    }
+    CHECK(pairs > 1000);
+    // Slivers whose lows along x differ only in the float key's low bytes (x = 1 + k 2^-23, floats
+    // apart, k < 512), all spanning the same y and z: the cells hold them all, and a wrong order
+    // among nearly equal lows stops a scan before a box it should meet.
+    for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+        CAPTURE(seed);
+        const bool self = seed % 2 == 0;
+        test::Rng rng(seed + 4000);
+        std::vector<Mesh> scene(2);
+        const auto x_at = [&] { return 1.0 + static_cast<double>(rng.below(512)) * 0x1p-23; };
+        for (Mesh& m : scene) {
+            for (std::uint32_t t = 0; t < 200; ++t) {
+                m.positions.push_back({x_at(), 0.0, 0.0});
+                m.positions.push_back({x_at(), 1.0, 0.0});
+                m.positions.push_back({x_at(), 0.5, 1.0});
+                m.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
+            }
+            // Anchors at x = 0 and x = 2 make x the longest extent of the pair's common box, so the
+            // sweep runs along x (plan_task).
+            for (const double x : {0.0, 2.0}) {
+                const auto b = static_cast<std::uint32_t>(m.positions.size());
+                m.positions.push_back({x, 0.0, 0.0});
+                m.positions.push_back({x, 1.0, 0.0});
+                m.positions.push_back({x, 0.5, 1.0});
+                m.triangles.push_back({b, b + 1, b + 2});
+            }
+        }
+        cullide::ExactStats st;
+        auto got = cullide::exact_pairs(scene, {self, 2}, &st);
+        REQUIRE(got.ok());
+        std::vector<std::vector<std::uint32_t>> welded;
+        const cullide::detail::ExactStageResult want = set_sweep(scene, self, welded);
+        CHECK(got.value() == want.pairs);
+        CHECK(got.value() == test::brute_force_pairs(scene, self));
+        CHECK(st.box_pairs == want.stats.tests);
+        CHECK(st.adjacent_skipped == want.stats.adjacent_skipped);
+    }
+}
+
 TEST_CASE("one big pair task, made in chunks on several workers, gives the serial task's pairs and counts") {
     // Two soups of 12,000 small triangles each over one box, in sets of 4 scattered triangles (so
     // every set is loose and make_task sweeps its triangles): one pair task, fewer tasks than
