@@ -8,7 +8,9 @@
 // Property (R-CULLIDE's guarantee, Govindaraju et al., "Fast reliable collision culling using
 // graphics hardware", 2004): the culling never drops a colliding pair and the exact stage removes
 // every false positive, so process_frame with rcullide, rcullide-offset and qcullide returns exactly
-// the pairs of exact_pairs (qcullide with self-collision: those of exact_pairs with self). Invalid
+// the pairs of exact_pairs (qcullide with self-collision: those of exact_pairs with self), and
+// exact_pairs itself, the last stage of every method, returns those of the brute-force twin
+// (tests/brute_force_pairs.h: every triangle pair, no prefilter), with and without self. Invalid
 // scenes (a bad index or a non-finite coordinate, injected on purpose now and then) must be rejected
 // by both or by neither. Any violation prints the scene and aborts.
 #include <algorithm>
@@ -24,6 +26,7 @@
 #include "cullide/mesh.h"
 #include "cullide/pipeline.h"
 #include "cullide/predicates.h"
+#include "brute_force_pairs.h"
 
 namespace {
 
@@ -165,6 +168,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const cullide::Result<std::vector<cullide::TrianglePair>> want_apart = cullide::exact_pairs(scene, exact_opt);
     exact_opt.self = true;
     const cullide::Result<std::vector<cullide::TrianglePair>> want_self = cullide::exact_pairs(scene, exact_opt);
+    // The ground truth against its brute-force twin (both reject or accept the same scenes: the
+    // twin needs a valid one, so it runs only where exact_pairs accepted it).
+    for (const bool self : {false, true}) {
+        const cullide::Result<std::vector<cullide::TrianglePair>>& exact = self ? want_self : want_apart;
+        if (exact && exact.value() != test::brute_force_pairs(scene, self))
+            fail(scene, opt, std::string("exact_pairs differs from the brute-force pairs") + (self ? " (self)" : ""));
+    }
     // Quick-CULLIDE (exact bounds) too, without and with self-collision: its views answer through
     // raster::WindowedPasses (each item rasterized once per view), which must keep the same
     // guarantee. (It takes no object-stage or min-prune options: they are CULLIDE's.)
