@@ -275,6 +275,22 @@ bool every_box_open_overlaps(const cullide::Frame& objects) {
     return true;
 }
 
+// f(name, frame number, objects) for five built-in scenes at scale 0.3, frames 0, 17 and 40.
+template <class F>
+void each_scene_frame(F&& f) {
+    for (const char* name : {"cylinders", "leaves", "breaking", "tori", "cloth"}) {
+        cullide::SceneOptions so;
+        so.scale = 0.3;
+        auto scene = cullide::make_scene(name, so);
+        REQUIRE(scene.ok());
+        for (int frame : {0, 17, 40}) {
+            CAPTURE(name);
+            CAPTURE(frame);
+            f(name, frame, scene.value()->frame(frame));
+        }
+    }
+}
+
 std::size_t box_views(const cullide::VisibilityStats& s) {
     return static_cast<std::size_t>(std::count_if(s.views.begin(), s.views.end(),
                                                   [](const cullide::ViewStats& v) { return v.stage == cullide::CullStage::Boxes; }));
@@ -286,53 +302,44 @@ TEST_CASE("after a broad phase rcullide skips its box views, which would prune n
     auto device = cullide::make_emulator_device(2);
     REQUIRE(device);
     std::size_t frames_with_dropped = 0;
-    for (const char* name : {"cylinders", "leaves", "breaking", "tori", "cloth"}) {
-        cullide::SceneOptions so;
-        so.scale = 0.3;
-        auto scene = cullide::make_scene(name, so);
-        REQUIRE(scene.ok());
-        for (int f : {0, 17, 40}) {
-            CAPTURE(name);
-            CAPTURE(f);
-            const cullide::Frame objects = scene.value()->frame(f);
-            const cullide::FrameResult skipped = run(objects, Method::RCullide, 32, 2, cullide::BroadPhase::SweepAndPrune);
-            const std::vector<std::uint32_t> active = overlapping_objects(objects);
-            REQUIRE(skipped.stats.broadphase_objects == active.size());
-            if (active.size() < objects.size()) ++frames_with_dropped;
-            CHECK(box_views(skipped.stats) == 0);
-            if (active.size() < 2) continue;
-            // The same objects with the box views run: they prune none of them, and everything after
-            // them is the same.
-            cullide::CullideOptions co;
-            co.mode = cullide::VisibilityMode::ExactBounds;
-            co.resolution = 32;
-            co.threads = 2;
-            REQUIRE(co.box_stage);
-            co.settle_box_views = false;  // run them (settled, they would prune nothing by construction)
-            cullide::CullideStats with;
-            auto pairs = cullide::cullide_pairs(objects, active, co, *device, &with);
-            REQUIRE_MESSAGE(pairs.ok(), pairs.error().message);
-            CHECK(box_views(with) > 0);
-            CHECK(with.pcs_boxes == active.size());
-            CHECK(pairs.value() == skipped.pairs);
-            CHECK(with.pcs_objects == skipped.stats.pcs_objects);
-            CHECK(with.subobjects == skipped.stats.subobjects);
-            CHECK(with.pcs_subobjects == skipped.stats.pcs_subobjects);
-            CHECK(with.subobject_pairs == skipped.stats.subobject_pairs);
-            CHECK(with.candidate_triangles == skipped.stats.candidate_triangles);
-            CHECK(with.exact_tests == skipped.stats.exact_tests);
-            // The sub-object views, one for one.
-            std::vector<cullide::ViewStats> later;
-            for (const cullide::ViewStats& v : with.views)
-                if (v.stage != cullide::CullStage::Boxes) later.push_back(v);
-            REQUIRE(later.size() == skipped.stats.views.size());
-            for (std::size_t v = 0; v < later.size(); ++v) {
-                CHECK(later[v].items_before == skipped.stats.views[v].items_before);
-                CHECK(later[v].items_after == skipped.stats.views[v].items_after);
-                CHECK(later[v].queries == skipped.stats.views[v].queries);
-            }
+    each_scene_frame([&](const char*, int, const cullide::Frame& objects) {
+        const cullide::FrameResult skipped = run(objects, Method::RCullide, 32, 2, cullide::BroadPhase::SweepAndPrune);
+        const std::vector<std::uint32_t> active = overlapping_objects(objects);
+        REQUIRE(skipped.stats.broadphase_objects == active.size());
+        if (active.size() < objects.size()) ++frames_with_dropped;
+        CHECK(box_views(skipped.stats) == 0);
+        if (active.size() < 2) return;
+        // The same objects with the box views run: they prune none of them, and everything after
+        // them is the same.
+        cullide::CullideOptions co;
+        co.mode = cullide::VisibilityMode::ExactBounds;
+        co.resolution = 32;
+        co.threads = 2;
+        REQUIRE(co.box_stage);
+        co.settle_box_views = false;  // run them (settled, they would prune nothing by construction)
+        cullide::CullideStats with;
+        auto pairs = cullide::cullide_pairs(objects, active, co, *device, &with);
+        REQUIRE_MESSAGE(pairs.ok(), pairs.error().message);
+        CHECK(box_views(with) > 0);
+        CHECK(with.pcs_boxes == active.size());
+        CHECK(pairs.value() == skipped.pairs);
+        CHECK(with.pcs_objects == skipped.stats.pcs_objects);
+        CHECK(with.subobjects == skipped.stats.subobjects);
+        CHECK(with.pcs_subobjects == skipped.stats.pcs_subobjects);
+        CHECK(with.subobject_pairs == skipped.stats.subobject_pairs);
+        CHECK(with.candidate_triangles == skipped.stats.candidate_triangles);
+        CHECK(with.exact_tests == skipped.stats.exact_tests);
+        // The sub-object views, one for one.
+        std::vector<cullide::ViewStats> later;
+        for (const cullide::ViewStats& v : with.views)
+            if (v.stage != cullide::CullStage::Boxes) later.push_back(v);
+        REQUIRE(later.size() == skipped.stats.views.size());
+        for (std::size_t v = 0; v < later.size(); ++v) {
+            CHECK(later[v].items_before == skipped.stats.views[v].items_before);
+            CHECK(later[v].items_after == skipped.stats.views[v].items_after);
+            CHECK(later[v].queries == skipped.stats.views[v].queries);
         }
-    }
+    });
     CHECK(frames_with_dropped > 0);  // the broad phase dropped objects somewhere, so the check above had room to differ
     // CULLIDE (GL-exact) keeps its box views after a broad phase: they may prune overlapping boxes.
     cullide::SceneOptions so;
@@ -389,18 +396,9 @@ TEST_CASE("rcullide settles its box views where every box overlaps another: the 
     auto device = cullide::make_emulator_device(2);
     REQUIRE(device);
     std::size_t settled_runs = 0, pruning_runs = 0;
-    for (const char* name : {"cylinders", "leaves", "breaking", "tori", "cloth"}) {
-        cullide::SceneOptions so;
-        so.scale = 0.3;
-        auto scene = cullide::make_scene(name, so);
-        REQUIRE(scene.ok());
-        for (int f : {0, 17, 40}) {
-            CAPTURE(name);
-            CAPTURE(f);
-            check_settled_box_views(scene.value()->frame(f), 32, raster::DepthFormat::D24, *device, settled_runs,
-                                    pruning_runs);
-        }
-    }
+    each_scene_frame([&](const char*, int, const cullide::Frame& objects) {
+        check_settled_box_views(objects, 32, raster::DepthFormat::D24, *device, settled_runs, pruning_runs);
+    });
     CHECK(settled_runs > 0);
     CHECK(pruning_runs > 0);
     // Boxes that only touch (a shared face, edge or corner on a coarse grid), flat and degenerate

@@ -187,6 +187,22 @@ cullide::detail::ExactStageResult set_sweep(const std::vector<Mesh>& scene, bool
     return cullide::detail::sweep_exact_stage(exact, sets, {self, false, 1});
 }
 
+// exact_pairs on `threads` threads against both twins: the set sweep (the pairs and every count)
+// and brute force (the pairs). Returns the set sweep's result.
+cullide::detail::ExactStageResult check_twins(const std::vector<Mesh>& scene, bool self, int threads) {
+    cullide::ExactStats st;
+    auto got = cullide::exact_pairs(scene, {self, threads}, &st);
+    REQUIRE(got.ok());
+    std::vector<std::vector<std::uint32_t>> welded;
+    cullide::detail::ExactStageResult want = set_sweep(scene, self, welded);
+    CHECK(got.value() == want.pairs);
+    CHECK(got.value() == test::brute_force_pairs(scene, self));
+    CHECK(st.candidate_triangles == want.stats.task_triangles);
+    CHECK(st.box_pairs == want.stats.tests);
+    CHECK(st.adjacent_skipped == want.stats.adjacent_skipped);
+    return want;
+}
+
 }  // namespace
 
 TEST_CASE("float_down and float_up give the nearest floats below and above, infinities beyond the range") {
@@ -324,16 +340,7 @@ TEST_CASE("the triangle sweep gives the set sweep's pairs and counts where float
         for (Mesh& m : scene)
             for (Vec3& p : m.positions)
                 for (int k = 0; k < 3; ++k) p[k] *= scale;
-        cullide::ExactStats st;
-        auto got = cullide::exact_pairs(scene, {self, 1 + static_cast<int>(seed % 3)}, &st);
-        REQUIRE(got.ok());
-        std::vector<std::vector<std::uint32_t>> welded;
-        const cullide::detail::ExactStageResult want = set_sweep(scene, self, welded);
-        CHECK(got.value() == want.pairs);
-        CHECK(got.value() == test::brute_force_pairs(scene, self));
-        CHECK(st.candidate_triangles == want.stats.task_triangles);
-        CHECK(st.box_pairs == want.stats.tests);
-        CHECK(st.adjacent_skipped == want.stats.adjacent_skipped);
+        const cullide::detail::ExactStageResult want = check_twins(scene, self, 1 + static_cast<int>(seed % 3));
         pairs += want.pairs.size();
         tests += want.stats.tests;
     }
@@ -359,15 +366,7 @@ TEST_CASE("a big object in many pair tasks (walked in spatial order) gives the s
                 big.positions.push_back(c + Vec3{rng.grid(-0.5, 0.5, 8), rng.grid(-0.5, 0.5, 8), rng.grid(-0.5, 0.5, 8)});
             big.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
         }
-        cullide::ExactStats st;
-        auto got = cullide::exact_pairs(scene, {false, 2}, &st);
-        REQUIRE(got.ok());
-        std::vector<std::vector<std::uint32_t>> welded;
-        const cullide::detail::ExactStageResult want = set_sweep(scene, false, welded);
-        CHECK(got.value() == want.pairs);
-        CHECK(got.value() == test::brute_force_pairs(scene, false));
-        CHECK(st.candidate_triangles == want.stats.task_triangles);
-        CHECK(st.box_pairs == want.stats.tests);
+        const cullide::detail::ExactStageResult want = check_twins(scene, false, 2);
         std::uint64_t with_big = 0;
         for (const TrianglePair& p : want.pairs) with_big += p.object_a == 0 ? 1 : 0;
         CHECK(with_big > 20);  // the big object really meets the others
@@ -403,16 +402,7 @@ TEST_CASE("dense cells sorted once per slab by radix give the set sweep's pairs 
                     m.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
             }
         }
-        cullide::ExactStats st;
-        auto got = cullide::exact_pairs(scene, {self, 2}, &st);
-        REQUIRE(got.ok());
-        std::vector<std::vector<std::uint32_t>> welded;
-        const cullide::detail::ExactStageResult want = set_sweep(scene, self, welded);
-        CHECK(got.value() == want.pairs);
-        CHECK(got.value() == test::brute_force_pairs(scene, self));
-        CHECK(st.candidate_triangles == want.stats.task_triangles);
-        CHECK(st.box_pairs == want.stats.tests);
-        CHECK(st.adjacent_skipped == want.stats.adjacent_skipped);
+        const cullide::detail::ExactStageResult want = check_twins(scene, self, 2);
         pairs += want.pairs.size();
     }
     CHECK(pairs > 1000);
@@ -442,15 +432,7 @@ TEST_CASE("dense cells sorted once per slab by radix give the set sweep's pairs 
                 m.triangles.push_back({b, b + 1, b + 2});
             }
         }
-        cullide::ExactStats st;
-        auto got = cullide::exact_pairs(scene, {self, 2}, &st);
-        REQUIRE(got.ok());
-        std::vector<std::vector<std::uint32_t>> welded;
-        const cullide::detail::ExactStageResult want = set_sweep(scene, self, welded);
-        CHECK(got.value() == want.pairs);
-        CHECK(got.value() == test::brute_force_pairs(scene, self));
-        CHECK(st.box_pairs == want.stats.tests);
-        CHECK(st.adjacent_skipped == want.stats.adjacent_skipped);
+        (void)check_twins(scene, self, 2);
     }
 }
 
