@@ -452,7 +452,9 @@ Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_
 // used for the box stage (one item per object), where R-CULLIDE's views are then known to prune
 // nothing without running them (CullideOptions::box_stage has the same argument). Sweep and prune
 // along x over the items sorted by box.lo.x, stopping with false after kMaxOverlapChecks per item
-// (boxes piled along x: the views then run as before).
+// (boxes piled along x: the views then run as before). Not detail::overlapping_sets: it lists every
+// overlapping pair (quadratic in a heap of boxes that all overlap), where this only needs a partner
+// for each box and gives up early.
 bool all_boxes_overlapped(const std::vector<ObjectGeometry>& g) {
     constexpr std::size_t kMaxOverlapChecks = 64;
     struct Entry {

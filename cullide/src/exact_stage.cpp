@@ -60,6 +60,21 @@ class PairTester {
         return test_if(oa, pa, ob, pb, near, out, [&] { return overlaps(boxes_a[pa], boxes_b[pb]); });
     }
 
+    // The triangle pairs of sets sa and sb (sa == sb: the set's own pairs) whose boxes overlap.
+    // Returns how many went to the exact test.
+    std::uint64_t test_sets(std::uint32_t sa, std::uint32_t sb, bool near, UnitOut& out) const {
+        const CandidateSet& a = sets_[sa];
+        const CandidateSet& b = sets_[sb];
+        const std::span<const Aabb> boxes_a = objects_[a.object].triangle_boxes;
+        const std::span<const Aabb> boxes_b = objects_[b.object].triangle_boxes;
+        std::uint64_t tested = 0;
+        for (std::uint32_t pa = a.first; pa < a.first + a.count; ++pa) {
+            for (std::uint32_t pb = sa == sb ? pa + 1 : b.first; pb < b.first + b.count; ++pb)
+                if (overlaps(boxes_a[pa], boxes_b[pb])) tested += test(a.object, pa, b.object, pb, near, out) ? 1 : 0;
+        }
+        return tested;
+    }
+
    private:
     // Adjacency (one object), then, if `boxes_meet()`, the exact test. Returns whether the pair went
     // to the exact test.
@@ -90,23 +105,6 @@ class PairTester {
         return true;
     }
 
-   public:
-    // The triangle pairs of sets sa and sb (sa == sb: the set's own pairs) whose boxes overlap.
-    // Returns how many went to the exact test.
-    std::uint64_t test_sets(std::uint32_t sa, std::uint32_t sb, bool near, UnitOut& out) const {
-        const CandidateSet& a = sets_[sa];
-        const CandidateSet& b = sets_[sb];
-        const std::span<const Aabb> boxes_a = objects_[a.object].triangle_boxes;
-        const std::span<const Aabb> boxes_b = objects_[b.object].triangle_boxes;
-        std::uint64_t tested = 0;
-        for (std::uint32_t pa = a.first; pa < a.first + a.count; ++pa) {
-            for (std::uint32_t pb = sa == sb ? pa + 1 : b.first; pb < b.first + b.count; ++pb)
-                if (overlaps(boxes_a[pa], boxes_b[pb])) tested += test(a.object, pa, b.object, pb, near, out) ? 1 : 0;
-        }
-        return tested;
-    }
-
-   private:
     static bool share_welded_vertex(const ExactObject& o, const Tri& a, const Tri& b) {
         for (std::uint32_t u : a)
             for (std::uint32_t v : b)

@@ -248,9 +248,10 @@ void merge_min_by_object(std::uint32_t* a1, std::uint32_t* ao, std::uint32_t* a2
                          const std::uint32_t* bo, const std::uint32_t* b2, std::size_t pixels) {
     merge_by_object(a1, ao, a2, b1, bo, b2, pixels, std::less<std::uint32_t>());
 }
-// The smallest value at pixel p over the objects other than obj (with the clear value).
-inline std::uint32_t other_min(const std::uint32_t* m1, const std::uint32_t* o1, const std::uint32_t* m2, std::size_t p,
-                               std::uint32_t obj) {
+// A record's first value at pixel p over the objects other than obj (the minima: the smallest, with
+// the clear value; by std::greater: the largest).
+template <class T>
+inline T other_than(const T* m1, const std::uint32_t* o1, const T* m2, std::size_t p, std::uint32_t obj) {
     return o1[p] == obj ? m2[p] : m1[p];
 }
 
@@ -702,7 +703,7 @@ void VisibilityPass::State::test_fragments(std::span<const VisibilityItem> items
     std::uint32_t last = kNoObject;
     for (const Fragment& f : fragments) {
         if (f.item == last) continue;
-        const std::uint32_t other = items[f.item].object == tile_obj1[f.pixel] ? tile_min2[f.pixel] : tile_min1[f.pixel];
+        const std::uint32_t other = other_than(tile_min1, tile_obj1, tile_min2, f.pixel, items[f.item].object);
         if (f.zmax >= other) {  // the GEQUAL query passes here
             std::atomic_ref<std::uint8_t>(hit[f.item]).store(1, std::memory_order_relaxed);
             last = f.item;
@@ -1068,7 +1069,7 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
         for (std::size_t i = first[part]; i < first[part + 1]; ++i) {
             const std::uint32_t obj = items[i].object;
             const bool not_hit = for_pixels(i, [&](const BoxBound& t, std::size_t p) {
-                return t.hi < other_min(m.c1.data(), m.co.data(), m.c2.data(), p, obj);
+                return t.hi < other_than(m.c1.data(), m.co.data(), m.c2.data(), p, obj);
             });
             if (not_hit) {
                 verdict[i] = kNotHit;
@@ -1077,7 +1078,7 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
             const VertexRec* rec = vrec.data() + rec_first[i];
             bool hit_sure = false;
             for (std::uint32_t k = 0; k < rec_count[i] && !hit_sure; ++k)
-                hit_sure = rec[k].zmax >= other_min(m.v1.data(), m.vo.data(), m.v2.data(), rec[k].pixel, obj);
+                hit_sure = rec[k].zmax >= other_than(m.v1.data(), m.vo.data(), m.v2.data(), rec[k].pixel, obj);
             if (hit_sure) {
                 verdict[i] = kHit;
                 continue;
@@ -1098,7 +1099,7 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
         for (std::size_t i = first[part]; i < first[part + 1]; ++i) {
             const std::uint32_t obj = items[i].object;
             drawn[i] = verdict[i] == kOpen || !for_pixels(i, [&](const BoxBound& t, std::size_t p) {
-                return (m.uo[p] == obj ? m.u2[p] : m.u1[p]) <= t.lo;
+                return other_than(m.u1.data(), m.uo.data(), m.u2.data(), p, obj) <= t.lo;
             });
         }
     });
