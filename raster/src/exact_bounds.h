@@ -398,6 +398,56 @@ struct WindowMap {
 // larger slack loses speed, never an answer.
 inline constexpr double kVertexSlack = 0x1p-30;
 
+// The pixels of a flat triangle that are certainly reported, with its depth: for a triangle whose
+// three window positions (WindowMap, every |coordinate| <= 1, so never clipped) have one depth z
+// (the same double: faces of boxes seen along an axis), every point of the triangle has depth z,
+// so kVertexSlack's argument holds at every pixel whose square holds a point of it, not only at
+// its vertices' pixels. f(pixel index) for each pixel of the target whose square, shrunk by
+// kFaceShrink on each side, the triangle certainly meets: separating-axis tests on the square's two
+// axes and the triangle's three edge normals, each passed with a margin far above the doubles'
+// roundings (window positions below 2^15, edges of at least kFaceMinEdge pixels; thinner or
+// smaller triangles give nothing). Missing a pixel loses speed, never an answer.
+inline constexpr double kFaceShrink = 0x1p-12;
+inline constexpr double kFaceMinEdge = 0x1p-4;
+template <class F>
+void flat_triangle_pixels(const BoundsVertex& a, const BoundsVertex& b, const BoundsVertex& c, int width, int height,
+                          F&& f) {
+    const double x0 = std::min(std::min(a.x, b.x), c.x), x1 = std::max(std::max(a.x, b.x), c.x);
+    const double y0 = std::min(std::min(a.y, b.y), c.y), y1 = std::max(std::max(a.y, b.y), c.y);
+    // Pixels whose shrunk square [p + s, p + 1 - s] overlaps [x0, x1] (and likewise in y).
+    const int px0 = std::max(0, static_cast<int>(std::ceil(x0 - 1.0 + kFaceShrink)));
+    const int px1 = std::min(width - 1, static_cast<int>(std::floor(x1 - kFaceShrink)));
+    const int py0 = std::max(0, static_cast<int>(std::ceil(y0 - 1.0 + kFaceShrink)));
+    const int py1 = std::min(height - 1, static_cast<int>(std::floor(y1 - kFaceShrink)));
+    if (px0 > px1 || py0 > py1) return;
+    // Edge u -> v with the third vertex w: the normal n toward w; the square's largest n . (q - u)
+    // over its shrunk corners is n . (centre - u) + (0.5 - s) (|n.x| + |n.y|).
+    struct Edge {
+        double nx, ny, ux, uy, reach;
+    };
+    Edge e[3];
+    const BoundsVertex* v[3] = {&a, &b, &c};
+    for (int k = 0; k < 3; ++k) {
+        const BoundsVertex& u = *v[k];
+        const BoundsVertex& t = *v[(k + 1) % 3];
+        const BoundsVertex& w = *v[(k + 2) % 3];
+        double nx = -(t.y - u.y), ny = t.x - u.x;
+        const double l1 = std::fabs(nx) + std::fabs(ny);
+        if (!(l1 >= kFaceMinEdge)) return;
+        if (nx * (w.x - u.x) + ny * (w.y - u.y) < 0.0) nx = -nx, ny = -ny;
+        // The third vertex must lie clearly off the edge: a sliver gives nothing.
+        if (!(nx * (w.x - u.x) + ny * (w.y - u.y) >= kFaceMinEdge * l1)) return;
+        e[k] = {nx, ny, u.x, u.y, (0.5 - 2.0 * kFaceShrink) * l1};
+    }
+    for (int py = py0; py <= py1; ++py)
+        for (int px = px0; px <= px1; ++px) {
+            const double cx = px + 0.5, cy = py + 0.5;
+            bool meets = true;
+            for (const Edge& g : e) meets = meets && g.nx * (cx - g.ux) + g.ny * (cy - g.uy) + g.reach > 0.0;
+            if (meets) f(static_cast<std::uint32_t>(py) * static_cast<std::uint32_t>(width) + static_cast<std::uint32_t>(px));
+        }
+}
+
 // ---- the per-pixel traversal shared by bounds_rect and the fused visibility pass ----
 
 struct BoundsP3 {

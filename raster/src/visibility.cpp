@@ -401,8 +401,12 @@ struct VisibilityPass::State {
     };
     std::vector<BoxBound> boxes;
     std::vector<VertexRec> vrec;
+    // Per item with face records (detail::flat_triangle_pixels), where they are in its part's PrePart::frec.
+    std::vector<std::uint32_t> face_first, face_count;
+    std::vector<std::uint64_t> face_hits;  // per part: items certainly hit by a face record
     std::vector<std::size_t> box_first, rec_first;  // per item, its first slot; then the slot count
-    std::vector<std::uint32_t> box_count, rec_count;  // per item
+    std::vector<std::uint32_t> box_count, rec_count;  // per item (rec_count: | kHasFaces, see face_first)
+    static constexpr std::uint32_t kHasFaces = 0x80000000u;
     std::vector<std::uint8_t> verdict;  // per item: kOpen, kNotHit, kHit
     std::vector<std::uint8_t> tested;   // per item of the pass: its fragments are tested
     // Per part of the pre-pass, per pixel: the minima of the boxes' lo (c*) and of the vertices'
@@ -410,6 +414,7 @@ struct VisibilityPass::State {
     struct PrePart {
         std::vector<std::uint32_t> c1, co, c2, v1, vo, v2, uo;
         std::vector<std::uint64_t> u1, u2;
+        std::vector<VertexRec> frec;         // the part's items' face records, in item order
         std::vector<std::uint32_t> vstamp;  // per vertex of the current run: mapped in generation gen
         std::vector<VertexMap> vcache;      // per vertex: what the run found
         std::uint32_t gen = 0;
@@ -863,6 +868,24 @@ void VisibilityPass::State::raster_part(std::span<const VisibilityItem> items, c
 // other object's box reaches its pixels, so the coarse minimum there is the clear value, above its
 // hi unless it reaches the far plane within a step of the encoding) and left out.
 
+namespace {
+// Whether one of an item's triangles (its vertices mapped: cache[index].win) spans the item's whole
+// window box [x0, x1] x [y0, y1]: then a box per triangle reaches no fewer pixels than the item's
+// box, and costs more (a box's faces seen along an axis: each face's triangles span the box).
+template <class Cache>
+bool spans_box(const Cache* cache, std::span<const std::uint32_t> indices, double x0, double x1, double y0, double y1) {
+    for (std::size_t k = 0; k < indices.size(); k += 3) {
+        const auto& a = cache[indices[k]].win;
+        const auto& b = cache[indices[k + 1]].win;
+        const auto& c = cache[indices[k + 2]].win;
+        if (std::min(std::min(a.x, b.x), c.x) == x0 && std::max(std::max(a.x, b.x), c.x) == x1 &&
+            std::min(std::min(a.y, b.y), c.y) == y0 && std::max(std::max(a.y, b.y), c.y) == y1)
+            return true;
+    }
+    return false;
+}
+}  // namespace
+
 int VisibilityPass::State::presettle(int width, int height, DepthFormat format, std::span<const VisibilityItem> items,
                                      int threads) {
     const std::size_t n = items.size();
@@ -888,6 +911,8 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
     rec_count.resize(n);
     verdict.resize(n);
     drawn.resize(n);
+    face_first.resize(n);
+    face_count.resize(n);
     // Every pixel of item i's boxes while f(box, pixel) is true; false when f stopped it.
     const auto for_pixels = [&](std::size_t i, auto&& f) __attribute__((always_inline)) {
         for (std::size_t b = box_first[i]; b < box_first[i] + box_count[i]; ++b) {
@@ -911,6 +936,7 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
         while (part < n_parts && rec_first[i] * n_parts >= total * part) first[part++] = i;
     if (pre.size() < n_parts) pre.resize(n_parts);
     pre_failed.assign(n_parts, 0);
+    face_hits.assign(n_parts, 0);
     pre_area.assign(2 * n_parts, 0);  // per part: pixels of its boxes; then per part: its triangles
     PrePart& m = pre[0];              // the merged records
 
@@ -929,6 +955,7 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
         ps.v1.assign(pixels, clear);
         ps.vo.assign(pixels, kNoObject);
         ps.v2.assign(pixels, clear);
+        ps.frec.clear();
         const Double4* run_vertices = nullptr;
         std::uint32_t run_object = kNoObject;
         std::uint64_t box_area = 0, triangles = 0;
@@ -1022,7 +1049,9 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
                     add_box(bx0, by0, bx1, by1, 0u, 0xffffffffu);
                 });
             } else if (n_idx > 0 && !boxer(x0, x1, y0, y1, z0, z1, n_idx > 3 ? detail::kReachSpread * (n_idx / 3) : 0,
-                                          add_box)) {
+                                          add_box) &&
+                       !(spans_box(ps.vcache.data(), mesh.indices, x0, x1, y0, y1) &&
+                         boxer(x0, x1, y0, y1, z0, z1, 0, add_box))) {
                 for (std::size_t k = 0; k < n_idx; k += 3) {  // scattered: a box per triangle
                     const detail::BoundsVertex& a = ps.vcache[mesh.indices[k]].win;
                     const detail::BoundsVertex& b = ps.vcache[mesh.indices[k + 1]].win;
@@ -1032,13 +1061,36 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
                           std::min(std::min(a.z, b.z), cc.z), std::max(std::max(a.z, b.z), cc.z), 0, add_box);
                 }
             }
+            // Flat triangles (one window depth: boxes' faces seen along an axis): a record at every
+            // pixel they certainly reach, not only at their vertices' (detail::flat_triangle_pixels).
+            // Only in items at least a pixel wide and high: in smaller ones the vertices' records
+            // are most of what a face could add (R-CULLIDE's sub-objects: the scan cost tori and
+            // breaking 2-3%).
+            // face_first and face_count are written only for such items (kHasFaces in rec_count).
+            const bool faces = all_inside && nbox > 0 && x1 - x0 >= 1.0 && y1 - y0 >= 1.0;
+            if (faces) {
+                face_first[i] = static_cast<std::uint32_t>(ps.frec.size());
+                for (std::size_t k = 0; k < n_idx; k += 3) {
+                    const detail::BoundsVertex& a = ps.vcache[mesh.indices[k]].win;
+                    const detail::BoundsVertex& b = ps.vcache[mesh.indices[k + 1]].win;
+                    const detail::BoundsVertex& cc = ps.vcache[mesh.indices[k + 2]].win;
+                    if (a.z != b.z || a.z != cc.z) continue;
+                    const std::uint32_t zmax = detail::encode_near(a.z - detail::kVertexSlack, format);
+                    const std::uint32_t zmin = detail::encode_near(a.z + detail::kVertexSlack, format);
+                    detail::flat_triangle_pixels(a, b, cc, width, height, [&](std::uint32_t pixel) {
+                        ps.frec.push_back({pixel, zmax});
+                        min_by_object(ps.v1.data(), ps.vo.data(), ps.v2.data(), pixel, obj, zmin);
+                    });
+                }
+                face_count[i] = static_cast<std::uint32_t>(ps.frec.size()) - face_first[i];
+            }
             box_count[i] = nbox;
             verdict[i] = kOpen;
             if (nbox > 0 && all_inside) {  // (a clipped item's box, the whole target, says nothing of its size)
                 box_area += item_area;
                 triangles += n_idx / 3;
             }
-            rec_count[i] = nrec;
+            rec_count[i] = nrec | (faces ? kHasFaces : 0u);
         }
         pre_area[part] = box_area;
         pre_area[n_parts + part] = triangles;
@@ -1077,8 +1129,15 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
             }
             const VertexRec* rec = vrec.data() + rec_first[i];
             bool hit_sure = false;
-            for (std::uint32_t k = 0; k < rec_count[i] && !hit_sure; ++k)
+            const std::uint32_t nrec = rec_count[i] & ~kHasFaces;
+            for (std::uint32_t k = 0; k < nrec && !hit_sure; ++k)
                 hit_sure = rec[k].zmax >= other_than(m.v1.data(), m.vo.data(), m.v2.data(), rec[k].pixel, obj);
+            if (!hit_sure && (rec_count[i] & kHasFaces) != 0) {
+                const VertexRec* face = ps.frec.data() + face_first[i];
+                for (std::uint32_t k = 0; k < face_count[i] && !hit_sure; ++k)
+                    hit_sure = face[k].zmax >= other_than(m.v1.data(), m.vo.data(), m.v2.data(), face[k].pixel, obj);
+                face_hits[part] += hit_sure ? 1 : 0;
+            }
             if (hit_sure) {
                 verdict[i] = kHit;
                 continue;
@@ -1122,6 +1181,7 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
         settled.items_not_hit += verdict[i] == kNotHit;
         settled.items_open += verdict[i] == kOpen;
     }
+    for (const std::uint64_t h : face_hits) settled.items_hit_by_face += h;
     return reduced.empty() ? 2 : 1;
 }
 

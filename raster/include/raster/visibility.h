@@ -49,6 +49,7 @@ struct VisibilityItem {
 struct PresettleStats {
     bool ran = false;
     std::uint64_t items_hit = 0;      // certainly not fully visible
+    std::uint64_t items_hit_by_face = 0;  // of those, shown by a flat triangle's inner pixel, not a vertex
     std::uint64_t items_not_hit = 0;  // certainly fully visible
     std::uint64_t items_open = 0;     // answered by the pass
     std::uint64_t triangles_left_out = 0;  // neither set up nor drawn
