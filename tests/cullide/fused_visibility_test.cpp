@@ -33,7 +33,7 @@ Outcome run(const cullide::Frame& frame, int resolution, raster::DepthFormat f, 
     auto device = cullide::make_emulator_device(threads);
     Outcome out;
     auto r = cullide::cullide_pairs(frame, active, o, *device, &out.stats);
-    REQUIRE_MESSAGE(r.ok(), r.error().message);
+    REQUIRE_MESSAGE(r.ok(), (r.ok() ? std::string() : r.error().message));
     out.pairs = std::move(r).value();
     return out;
 }
