@@ -223,8 +223,11 @@ BoundsReach bounds_reach(const FrontEndParams& params, const MeshViewD& mesh, De
         const std::uint32_t i = mesh.indices[k];
         if (i >= nv) return BoundsReach{0, 0, -1, -1, 0xffffffffu, false, true, true};
         const Double4& v = mesh.vertices[i];
+        // (Each coordinate compared on its own: std::max drops a NaN in its second argument.)
+        if (v.w != 1.0 || !(std::fabs(v.x) <= kMaxExactBoundsCoordinate && std::fabs(v.y) <= kMaxExactBoundsCoordinate &&
+                            std::fabs(v.z) <= kMaxExactBoundsCoordinate))
+            return BoundsReach{0, 0, -1, -1, 0xffffffffu, false, true, true};
         const double m = std::max(std::max(std::fabs(v.x), std::fabs(v.y)), std::fabs(v.z));
-        if (v.w != 1.0 || !(m <= kMaxExactBoundsCoordinate)) return BoundsReach{0, 0, -1, -1, 0xffffffffu, false, true, true};
         absmax = m > absmax ? m : absmax;
         cx0 = std::min(cx0, v.x), cx1 = std::max(cx1, v.x);
         cy0 = std::min(cy0, v.y), cy1 = std::max(cy1, v.y);

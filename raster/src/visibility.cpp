@@ -1010,10 +1010,11 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
                 if (ps.vstamp[v] != ps.gen) {
                     ps.vstamp[v] = ps.gen;
                     const Double4& d = mesh.vertices[v];
+                    // (valid_vertex compares each coordinate: std::max drops a NaN in its second argument.)
                     const double mag = std::max(std::max(std::fabs(d.x), std::fabs(d.y)), std::fabs(d.z));
-                    c.state = d.w != 1.0 || !(mag <= kMaxExactBoundsCoordinate) ? VertexMap::kBad
-                              : mag <= 1.0                                   ? VertexMap::kInside
-                                                                             : VertexMap::kBeyond;
+                    c.state = !valid_vertex(d) ? VertexMap::kBad
+                              : mag <= 1.0     ? VertexMap::kInside
+                                               : VertexMap::kBeyond;
                     if (c.state == VertexMap::kInside) {
                         c.win = window(d);
                         c.pixel = kNoObject;  // outside the target: no fragment to name
