@@ -1076,11 +1076,16 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
                     const detail::BoundsVertex& b = ps.vcache[mesh.indices[k + 1]].win;
                     const detail::BoundsVertex& cc = ps.vcache[mesh.indices[k + 2]].win;
                     if (a.z != b.z || a.z != cc.z) continue;
+                    // Only the item's farthest faces bound its queries' zmax from below usefully, and
+                    // only its nearest bound its writes' zmin from above (a box: its far face and its
+                    // near face; a flat item: every triangle both); a face between gives nothing.
+                    const bool query = a.z == z1, write = a.z == z0;
+                    if (!query && !write) continue;
                     const std::uint32_t zmax = detail::encode_near(a.z - detail::kVertexSlack, format);
                     const std::uint32_t zmin = detail::encode_near(a.z + detail::kVertexSlack, format);
                     detail::flat_triangle_pixels(a, b, cc, width, height, [&](std::uint32_t pixel) {
-                        ps.frec.push_back({pixel, zmax});
-                        min_by_object(ps.v1.data(), ps.vo.data(), ps.v2.data(), pixel, obj, zmin);
+                        if (query) ps.frec.push_back({pixel, zmax});
+                        if (write) min_by_object(ps.v1.data(), ps.vo.data(), ps.v2.data(), pixel, obj, zmin);
                     });
                 }
                 face_count[i] = static_cast<std::uint32_t>(ps.frec.size()) - face_first[i];
