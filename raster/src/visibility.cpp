@@ -869,20 +869,27 @@ void VisibilityPass::State::raster_part(std::span<const VisibilityItem> items, c
 // hi unless it reaches the far plane within a step of the encoding) and left out.
 
 namespace {
-// Whether one of an item's triangles (its vertices mapped: cache[index].win) spans the item's whole
-// window box [x0, x1] x [y0, y1]: then a box per triangle reaches no fewer pixels than the item's
-// box, and costs more (a box's faces seen along an axis: each face's triangles span the box).
+// Whether a box per triangle would say nothing more than the item's one box: one of its triangles
+// (vertices mapped: cache[index].win) spans its whole window box [x0, x1] x [y0, y1] at its smallest
+// depth z0, and one (the same or another) at its largest z1. Then at every pixel of the item's box
+// the triangles' boxes reach, between them, down to the item's lo and up to its hi, as the item's
+// box does, and a box per triangle only costs more (a box's faces seen along an axis: its near face
+// spans the box at z0, its far face at z1). Otherwise the triangles' own depth ranges are tighter.
 template <class Cache>
-bool spans_box(const Cache* cache, std::span<const std::uint32_t> indices, double x0, double x1, double y0, double y1) {
-    for (std::size_t k = 0; k < indices.size(); k += 3) {
+bool spans_box(const Cache* cache, std::span<const std::uint32_t> indices, double x0, double x1, double y0, double y1,
+               double z0, double z1) {
+    bool near = false, far = false;
+    for (std::size_t k = 0; k < indices.size() && !(near && far); k += 3) {
         const auto& a = cache[indices[k]].win;
         const auto& b = cache[indices[k + 1]].win;
         const auto& c = cache[indices[k + 2]].win;
-        if (std::min(std::min(a.x, b.x), c.x) == x0 && std::max(std::max(a.x, b.x), c.x) == x1 &&
-            std::min(std::min(a.y, b.y), c.y) == y0 && std::max(std::max(a.y, b.y), c.y) == y1)
-            return true;
+        if (std::min(std::min(a.x, b.x), c.x) != x0 || std::max(std::max(a.x, b.x), c.x) != x1 ||
+            std::min(std::min(a.y, b.y), c.y) != y0 || std::max(std::max(a.y, b.y), c.y) != y1)
+            continue;
+        near = near || std::min(std::min(a.z, b.z), c.z) == z0;
+        far = far || std::max(std::max(a.z, b.z), c.z) == z1;
     }
-    return false;
+    return near && far;
 }
 }  // namespace
 
@@ -1051,7 +1058,7 @@ int VisibilityPass::State::presettle(int width, int height, DepthFormat format, 
                 });
             } else if (n_idx > 0 && !boxer(x0, x1, y0, y1, z0, z1, n_idx > 3 ? detail::kReachSpread * (n_idx / 3) : 0,
                                           add_box) &&
-                       !(spans_box(ps.vcache.data(), mesh.indices, x0, x1, y0, y1) &&
+                       !(spans_box(ps.vcache.data(), mesh.indices, x0, x1, y0, y1, z0, z1) &&
                          boxer(x0, x1, y0, y1, z0, z1, 0, add_box))) {
                 for (std::size_t k = 0; k < n_idx; k += 3) {  // scattered: a box per triangle
                     const detail::BoundsVertex& a = ps.vcache[mesh.indices[k]].win;
