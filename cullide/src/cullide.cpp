@@ -336,22 +336,54 @@ Status prepare_view(std::vector<ObjectGeometry>& g, const std::vector<std::size_
         if (o.mode != VisibilityMode::Offset) {
             // Parts of detail::kTransformPart points per parallel job, each writing only its own
             // part of its object's clip arrays; the first failure in order is reported, named by
-            // the whole object's transform.
+            // the whole object's transform. Exact-bounds sub-object views read only the live items'
+            // vertices: where those items hold fewer indices than the object has points (every
+            // view after the first on the leaves and the cylinders), only the points they name
+            // are transformed, one job per such object (`items`: neighbouring items share points,
+            // so no two jobs write one), by the same arithmetic, so those points get the same
+            // values and nothing reads the others.
             struct Part {
-                std::size_t k, b, e;
+                std::size_t k, b, e;  // points [b, e) of order[k]; with `items`, its items [b, e)
+                bool items;
             };
             std::vector<Part> parts;
+            const bool sparse_ok = o.mode == VisibilityMode::ExactBounds && stage == CullStage::SubObjects;
             for (std::size_t k = 0; k < order.size(); ++k) {
                 ObjectGeometry& og = g[order[k]];
                 const std::size_t n = og.positions.size();
                 og.clip_d.resize(n);
                 if (o.mode == VisibilityMode::GLExact) og.clip.resize(n);
+                std::size_t live = 0;
+                for (const Item& it : og.items) live += it.live ? it.index_count : 0;
+                if (sparse_ok && live < n) {  // one part: neighbouring items share points
+                    parts.push_back({k, 0, og.items.size(), true});
+                    continue;
+                }
                 for (std::size_t b = 0; b < n; b += detail::kTransformPart)
-                    parts.push_back({k, b, std::min(n, b + detail::kTransformPart)});
+                    parts.push_back({k, b, std::min(n, b + detail::kTransformPart), false});
             }
             std::vector<char> ok(parts.size(), 0);
             detail::parallel_chunks(o.threads, parts.size(), [&](std::size_t j) {
                 ObjectGeometry& og = g[order[parts[j].k]];
+                if (parts[j].items) {
+                    // Runs of adjacent live items as one index span each.
+                    ok[j] = 1;
+                    for (std::size_t i = parts[j].b; i < parts[j].e && ok[j];) {
+                        if (!og.items[i].live) {
+                            ++i;
+                            continue;
+                        }
+                        const std::size_t first = og.items[i].first_index;
+                        std::size_t end = first + og.items[i].index_count;
+                        for (++i; i < parts[j].e && og.items[i].live && og.items[i].first_index == end; ++i)
+                            end += og.items[i].index_count;
+                        ok[j] = raster::ortho_view_to_clip(
+                                    view.value(), og.positions,
+                                    std::span<const std::uint32_t>(og.indices).subspan(first, end - first), og.clip_d)
+                                    ? 1 : 0;
+                    }
+                    return;
+                }
                 const std::size_t b = parts[j].b, len = parts[j].e - parts[j].b;
                 const std::span<raster::Float4> clip =
                     o.mode == VisibilityMode::GLExact ? std::span<raster::Float4>(og.clip).subspan(b, len)

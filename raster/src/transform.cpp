@@ -130,19 +130,47 @@ namespace {
 // constants. Returns the index of the first point whose clip coordinates are not all finite, or
 // points.size(). A point with a coordinate that is not finite is one of those: (inf - lo) * scale
 // is an infinity or NaN, and NaN stays NaN.
+// The view's box corner and scale along its (u, v, d) axes, and d: chosen once per call, not per
+// point (view_axes per point was 3% of a leaves / rcullide frame, with the transform itself 5%,
+// perf). Every ortho_view_to_clip uses them, so each gives a point the same values.
+struct ClipParams {
+    Double3 lo, scale;
+    int d = 0;
+};
+ClipParams clip_params(const OrthoView& view) {
+    ClipParams c;
+    c.lo = view_axes(view, view.box_min);
+    const Double3 hi = view_axes(view, view.box_max);
+    for (int k = 0; k < 3; ++k) axis_ref(c.scale, k) = 2.0 / (axis_of(hi, k) - axis_of(c.lo, k));
+    int u = 0, v = 0;
+    view_axis_indices(view.axis, u, v, c.d);
+    return c;
+}
+
+// One point's transform (the arithmetic of every ortho_view_to_clip); false when a result is not
+// finite.
+template <int U, int V, int D>
+inline bool point_to_clip(const Double3& lo, const Double3& scale, const Double3& p, Double4& c) {
+    const auto at = [](const Double3& q, auto k) { return k == 0 ? q.x : (k == 1 ? q.y : q.z); };
+    c.x = (at(p, std::integral_constant<int, U>{}) - lo.x) * scale.x - 1.0;
+    c.y = (at(p, std::integral_constant<int, V>{}) - lo.y) * scale.y - 1.0;
+    c.z = (at(p, std::integral_constant<int, D>{}) - lo.z) * scale.z - 1.0;
+    c.w = 1.0;
+    return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z);
+}
 template <int U, int V, int D>
 std::size_t to_clip(const Double3& lo, const Double3& scale, std::span<const Double3> points, Double4* out) {
-    const auto at = [](const Double3& p, auto k) { return k == 0 ? p.x : (k == 1 ? p.y : p.z); };
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        const Double3& p = points[i];
-        Double4& c = out[i];
-        c.x = (at(p, std::integral_constant<int, U>{}) - lo.x) * scale.x - 1.0;
-        c.y = (at(p, std::integral_constant<int, V>{}) - lo.y) * scale.y - 1.0;
-        c.z = (at(p, std::integral_constant<int, D>{}) - lo.z) * scale.z - 1.0;
-        c.w = 1.0;
-        if (!(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z))) return i;
-    }
+    for (std::size_t i = 0; i < points.size(); ++i)
+        if (!point_to_clip<U, V, D>(lo, scale, points[i], out[i])) return i;
     return points.size();
+}
+// The points `which` names; returns the position in `which` of the first failure, or which.size().
+template <int U, int V, int D>
+std::size_t to_clip_at(const Double3& lo, const Double3& scale, std::span<const Double3> points,
+                       std::span<const std::uint32_t> which, Double4* out) {
+    for (std::size_t k = 0; k < which.size(); ++k)
+        if (!point_to_clip<U, V, D>(lo, scale, points[which[k]], out[which[k]])) return k;
+    return which.size();
 }
 
 }  // namespace
@@ -158,17 +186,10 @@ Result<std::size_t> ortho_view_to_clip(const OrthoView& view, std::span<const Do
     if (out.size() != points.size())
         return Error{"ortho_view_to_clip: the output holds " + std::to_string(out.size()) + " points for " +
                      std::to_string(points.size())};
-    const Double3 lo = view_axes(view, view.box_min);
-    const Double3 hi = view_axes(view, view.box_max);
-    Double3 scale;
-    for (int k = 0; k < 3; ++k) axis_ref(scale, k) = 2.0 / (axis_of(hi, k) - axis_of(lo, k));
-    // The axes chosen once per call, not per point (view_axes per point was 3% of a leaves /
-    // rcullide frame, with the transform itself 5%, perf). The same arithmetic on the same values.
-    int u = 0, v = 0, d = 0;
-    view_axis_indices(view.axis, u, v, d);
-    const std::size_t bad = d == 0   ? to_clip<1, 2, 0>(lo, scale, points, out.data())
-                            : d == 1 ? to_clip<2, 0, 1>(lo, scale, points, out.data())
-                                     : to_clip<0, 1, 2>(lo, scale, points, out.data());
+    const ClipParams c = clip_params(view);
+    const std::size_t bad = c.d == 0   ? to_clip<1, 2, 0>(c.lo, c.scale, points, out.data())
+                            : c.d == 1 ? to_clip<2, 0, 1>(c.lo, c.scale, points, out.data())
+                                       : to_clip<0, 1, 2>(c.lo, c.scale, points, out.data());
     if (bad != points.size()) {
         const Double3& p = points[bad];  // the first offence, named as before: its input, or the overflow
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
@@ -176,6 +197,29 @@ Result<std::size_t> ortho_view_to_clip(const OrthoView& view, std::span<const Do
         return Error{"ortho_view_to_clip: point " + std::to_string(bad) + " overflows the double range in clip space"};
     }
     return points.size();
+}
+
+Result<std::size_t> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points,
+                                       std::span<const std::uint32_t> which, std::span<Double4> out) {
+    if (out.size() != points.size())
+        return Error{"ortho_view_to_clip: the output holds " + std::to_string(out.size()) + " points for " +
+                     std::to_string(points.size())};
+    for (const std::uint32_t i : which)
+        if (i >= points.size())
+            return Error{"ortho_view_to_clip: index " + std::to_string(i) + " is out of range (" +
+                         std::to_string(points.size()) + " points)"};
+    const ClipParams c = clip_params(view);
+    const std::size_t bad = c.d == 0   ? to_clip_at<1, 2, 0>(c.lo, c.scale, points, which, out.data())
+                            : c.d == 1 ? to_clip_at<2, 0, 1>(c.lo, c.scale, points, which, out.data())
+                                       : to_clip_at<0, 1, 2>(c.lo, c.scale, points, which, out.data());
+    if (bad != which.size()) {
+        const std::size_t at = which[bad];
+        const Double3& p = points[at];
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+            return Error{"ortho_view_to_clip: point " + std::to_string(at) + " is not finite"};
+        return Error{"ortho_view_to_clip: point " + std::to_string(at) + " overflows the double range in clip space"};
+    }
+    return which.size();
 }
 
 Result<std::vector<Double4>> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points) {

@@ -113,7 +113,7 @@ bool box_contains_balls(const raster::OrthoView& v, const raster::OffsetMesh& m,
 
 }  // namespace
 
-TEST_CASE("ortho_view_to_clip is the per-point formula bit for bit, and names the first bad point as non-finite or overflowing") {
+TEST_CASE("ortho_view_to_clip is the per-point formula bit for bit (all points, a part or named ones), and names the first bad point") {
     test::Rng rng(12);
     std::size_t compared = 0;
     for (int rep = 0; rep < 90; ++rep) {
@@ -144,6 +144,23 @@ TEST_CASE("ortho_view_to_clip is the per-point formula bit for bit, and names th
             CHECK(part_out[i].x == (inside ? c.value()[i].x : 7.0));
             CHECK(part_out[i].z == (inside ? c.value()[i].z : 7.0));
         }
+        // The overload for named points (repeats allowed) writes those and nothing else, the same bits.
+        std::vector<raster::Double4> named_out(pts.size(), raster::Double4{7, 7, 7, 7});
+        const std::vector<std::uint32_t> which = {3, 1, 3, 4};
+        auto named = raster::ortho_view_to_clip(v, pts, which, named_out);
+        REQUIRE(named.ok());
+        CHECK(named.value() == 4);
+        for (std::size_t i = 0; i < pts.size(); ++i) {
+            const bool listed = i == 1 || i == 3 || i == 4;
+            CHECK(named_out[i].x == (listed ? c.value()[i].x : 7.0));
+            CHECK(named_out[i].y == (listed ? c.value()[i].y : 7.0));
+            CHECK(named_out[i].z == (listed ? c.value()[i].z : 7.0));
+            CHECK(named_out[i].w == (listed ? 1.0 : 7.0));
+        }
+        const std::vector<std::uint32_t> beyond = {0, 5};
+        auto out_of_range = raster::ortho_view_to_clip(v, pts, beyond, named_out);
+        REQUIRE_FALSE(out_of_range.ok());
+        CHECK(out_of_range.error().message == "ortho_view_to_clip: index 5 is out of range (5 points)");
         auto wrong = raster::ortho_view_to_clip(v, pts, std::span<raster::Double4>(part_out).subspan(0, 2));
         REQUIRE_FALSE(wrong.ok());
         CHECK(wrong.error().message == "ortho_view_to_clip: the output holds 2 points for 5");
@@ -155,6 +172,14 @@ TEST_CASE("ortho_view_to_clip is the per-point formula bit for bit, and names th
         auto e = raster::ortho_view_to_clip(v, broken);
         REQUIRE_FALSE(e.ok());
         CHECK(e.error().message == "ortho_view_to_clip: point " + std::to_string(bad) + " is not finite");
+        // Named: the point's index in the list of points, not its place in `which`; a list that
+        // leaves it out transforms the others.
+        const std::vector<std::uint32_t> with_bad = {0, static_cast<std::uint32_t>(bad)};
+        auto en = raster::ortho_view_to_clip(v, broken, with_bad, named_out);
+        REQUIRE_FALSE(en.ok());
+        CHECK(en.error().message == "ortho_view_to_clip: point " + std::to_string(bad) + " is not finite");
+        const std::vector<std::uint32_t> without_bad = {0};
+        CHECK(raster::ortho_view_to_clip(v, broken, without_bad, named_out).ok());
         // On a tiny box (scale 2e300 per unit) a finite point far outside overflows in clip space.
         auto tiny = raster::make_ortho_view(axis, {0, 0, 0}, {1e-300, 1e-300, 1e-300}, 8, 8, raster::DepthFormat::D24);
         REQUIRE(tiny.ok());

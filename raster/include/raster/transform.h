@@ -88,6 +88,13 @@ void view_axis_indices(Axis axis, int& u, int& v, int& d);
 // Errors name the index within `points`.
 [[nodiscard]] Result<std::size_t> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points,
                                                      std::span<Double4> out);
+// The same for the points that `which` names only (out[i] = the transform of points[i] for each i in
+// `which`, by the same arithmetic, so bit for bit the values above; a point may be named several
+// times; the other elements of `out` are left as they are): for a caller whose draws read only
+// some of a mesh's vertices. `out` must hold points.size() elements; an index out of range is an
+// error, and so is a non-finite point or result (naming its index in `points`).
+[[nodiscard]] Result<std::size_t> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points,
+                                                     std::span<const std::uint32_t> which, std::span<Double4> out);
 
 // The view's cell in world units: dx, dy = one pixel along u, v; dz = one depth quantum along d
 // (D16: 1/65535, D24: 1/16777215, D32F: 2^-24, the largest float spacing in [0.5, 1]) times the
