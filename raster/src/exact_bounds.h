@@ -424,7 +424,10 @@ void flat_triangle_pixels(const BoundsVertex& a, const BoundsVertex& b, const Bo
     const int py1 = std::min(height - 1, static_cast<int>(std::floor(y1 - kFaceShrink)));
     if (px0 > px1 || py0 > py1) return;
     // Edge u -> v with the third vertex w: the normal n toward w; the square's largest n . (q - u)
-    // over its shrunk corners is n . (centre - u) + (0.5 - s) (|n.x| + |n.y|).
+    // over its corners, shrunk by s, is n . (centre - u) + (0.5 - s) (|n.x| + |n.y|). The test
+    // below shrinks by 2s: the extra s (at least 2^-16 for edges of 1/16 pixel) dwarfs the
+    // roundings of these products (below 2^-17 at |window| < 2^15), so passing it in doubles
+    // means passing the exact test for the square shrunk by s, as the pixel range above does.
     struct Edge {
         double nx, ny, ux, uy, reach;
     };
