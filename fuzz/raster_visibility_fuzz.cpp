@@ -10,7 +10,10 @@
 // Property: the per-item answers of the fused pass (pre-pass on, fresh and reused; pre-pass off;
 // 1 and 3 threads) equal the two recorded passes run through raster::execute_reference
 // (tests/raster/recorded_visibility.h); input with a non-finite or out-of-range vertex is rejected
-// by both. Any violation aborts.
+// by both. On valid input, also raster::WindowedPasses (Quick-CULLIDE's passes: windows, unused
+// items and masks from the input; both directions; 1 and 3 threads) equals its recorded form.
+// Any violation aborts.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -38,13 +41,15 @@ class Reader {
 
 // Tallies for the docs (printed at exit when RASTER_FUZZ_STATS is set).
 struct Stats {
-    unsigned long long runs = 0, rejected = 0, items = 0, hit = 0, settled_hit = 0, by_face = 0, not_hit = 0;
+    unsigned long long runs = 0, rejected = 0, items = 0, hit = 0, settled_hit = 0, by_face = 0, not_hit = 0,
+                       windowed = 0, windowed_hit = 0;
     ~Stats() {
         if (std::getenv("RASTER_FUZZ_STATS") != nullptr)
             std::fprintf(stderr,
                          "raster_visibility_fuzz: %llu runs, %llu rejected, %llu items (%llu hit); pre-pass: "
-                         "%llu certainly hit (%llu by a face), %llu certainly not\n",
-                         runs, rejected, items, hit, settled_hit, by_face, not_hit);
+                         "%llu certainly hit (%llu by a face), %llu certainly not; %llu windowed scenes (%llu "
+                         "queries passed)\n",
+                         runs, rejected, items, hit, settled_hit, by_face, not_hit, windowed, windowed_hit);
     }
 };
 Stats g_stats;
@@ -218,5 +223,38 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     g_stats.settled_hit += st.items_hit;
     g_stats.by_face += st.items_hit_by_face;
     g_stats.not_hit += st.items_not_hit;
+
+    // Quick-CULLIDE's windowed passes over the same (valid) items: per item a window [lo, hi]
+    // around it (non-decreasing over the items), whether it is used, and the query and write masks
+    // (an unused item neither), from the rest of the input; both directions, 1 and 3 threads,
+    // against the recorded windowed pass.
+    const std::size_t n = s.items.size();
+    std::vector<std::uint32_t> lo(n), hi(n);
+    std::vector<std::uint8_t> query(n), write(n);
+    std::vector<raster::WindowedItem> windowed(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::uint8_t shape = in.byte();
+        lo[i] = static_cast<std::uint32_t>(i - std::min<std::size_t>(i, shape % 4));
+        hi[i] = static_cast<std::uint32_t>(std::min(n - 1, i + (shape >> 2) % 4));
+        if (i > 0) lo[i] = std::max(lo[i], lo[i - 1]), hi[i] = std::max(hi[i], hi[i - 1]);
+        const bool used = (shape & 0x10U) == 0;
+        query[i] = used && (shape & 0x20U) == 0 ? 1 : 0;
+        write[i] = used && (shape & 0x40U) == 0 ? 1 : 0;
+        windowed[i] = {raster::MeshViewD{s.vertices, s.items[i]}, lo[i], hi[i], used};
+    }
+    for (const int threads : {1, 3}) {
+        raster::WindowedPasses passes;
+        const auto prepared = passes.prepare(w, h, format, windowed, threads);
+        if (!prepared.ok()) fail("windowed passes refused items the recorded passes accept");
+        for (const bool forward : {true, false}) {
+            const auto got = passes.run(forward, query, write);
+            const auto ref = test::recorded_windowed(s.vertices, s.items, lo, hi, query, write, forward, w, h, format);
+            if (!got.ok() || !ref) fail("windowed pass or its recorded form failed on valid input");
+            if (got.value() != *ref) fail("windowed pass differs from the recorded windowed pass");
+            if (threads == 1)
+                for (std::size_t i = 0; i < n; ++i) g_stats.windowed_hit += query[i] && got.value()[i] ? 1 : 0;
+        }
+    }
+    ++g_stats.windowed;
     return 0;
 }

@@ -900,39 +900,10 @@ std::vector<std::uint8_t> recorded_windowed(const Scene& s, const std::vector<st
                                             const std::vector<std::uint32_t>& hi, const std::vector<std::uint8_t>& query,
                                             const std::vector<std::uint8_t>& write, bool forward, int w, int h,
                                             DepthFormat f) {
-    const std::size_t n = s.item_indices.size();
-    raster::DrawState q;
-    q.mode = raster::RasterMode::ExactBounds;
-    q.depth_func = raster::DepthFunc::GEqual;
-    q.depth_write = false;
-    raster::DrawState d = q;
-    d.depth_func = raster::DepthFunc::LEqual;
-    d.depth_write = true;
-    raster::CommandBatch batch(w, h);
-    std::vector<std::int64_t> slot(n, -1);
-    std::size_t cursor = 0;
-    for (std::size_t step = 0; step < n; ++step) {
-        const std::size_t k = forward ? step : n - 1 - step;
-        if (query[k]) {
-            slot[k] = batch.begin_query(raster::QueryKind::AnySamplesPassed);
-            batch.draw(raster::MeshViewD{s.vertices, s.item_indices[k]}, q);
-            batch.end_query();
-        }
-        if (step + 1 == n) break;
-        for (; cursor < n; ++cursor) {
-            const std::size_t j = forward ? cursor : n - 1 - cursor;
-            if (forward ? hi[j] > k : lo[j] < k) break;
-            if (write[j]) batch.draw(raster::MeshViewD{s.vertices, s.item_indices[j]}, d);
-        }
-    }
-    auto target = raster::DepthTarget::create(w, h, f);
-    REQUIRE(target.ok());
-    auto r = raster::execute_reference(target.value(), batch, raster::ExecuteOptions{1});
-    REQUIRE_MESSAGE(r.ok(), (r.ok() ? std::string() : r.error().message));
-    std::vector<std::uint8_t> passed(n, 0);
-    for (std::size_t k = 0; k < n; ++k)
-        if (slot[k] >= 0 && r.value()[static_cast<std::size_t>(slot[k])] != 0) passed[k] = 1;
-    return passed;
+    std::string error;
+    const auto r = test::recorded_windowed(s.vertices, s.item_indices, lo, hi, query, write, forward, w, h, f, &error);
+    REQUIRE_MESSAGE(r.has_value(), error);
+    return *r;
 }
 
 // prepare() with `threads`, then both passes against recorded_windowed; counts the queried items'
