@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <type_traits>
 
@@ -126,10 +127,6 @@ Double3 view_axes(const OrthoView& view, Double3 world) {
 
 namespace {
 
-// The transform of ortho_view_to_clip with the view's axes (u, v, d: view_axis_indices) as
-// constants. Returns the index of the first point whose clip coordinates are not all finite, or
-// points.size(). A point with a coordinate that is not finite is one of those: (inf - lo) * scale
-// is an infinity or NaN, and NaN stays NaN.
 // The view's box corner and scale along its (u, v, d) axes, and d: chosen once per call, not per
 // point (view_axes per point was 3% of a leaves / rcullide frame, with the transform itself 5%,
 // perf). Every ortho_view_to_clip uses them, so each gives a point the same values.
@@ -158,19 +155,38 @@ inline bool point_to_clip(const Double3& lo, const Double3& scale, const Double3
     c.w = 1.0;
     return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z);
 }
-template <int U, int V, int D>
-std::size_t to_clip(const Double3& lo, const Double3& scale, std::span<const Double3> points, Double4* out) {
-    for (std::size_t i = 0; i < points.size(); ++i)
-        if (!point_to_clip<U, V, D>(lo, scale, points[i], out[i])) return i;
-    return points.size();
+// The transform of the points at(0) .. at(count - 1) (indices into points and out) with the view's
+// axes (u, v, d: view_axis_indices) as constants. Returns the first k whose point's clip
+// coordinates are not all finite, or count. A point with a coordinate that is not finite is one of
+// those: (inf - lo) * scale is an infinity or NaN, and NaN stays NaN.
+template <class At>
+std::size_t to_clip(const ClipParams& c, std::span<const Double3> points, std::size_t count, At at, Double4* out) {
+    const auto run = [&](auto u, auto v, auto d) {
+        for (std::size_t k = 0; k < count; ++k) {
+            const std::size_t i = at(k);
+            if (!point_to_clip<decltype(u)::value, decltype(v)::value, decltype(d)::value>(c.lo, c.scale, points[i],
+                                                                                           out[i]))
+                return k;
+        }
+        return count;
+    };
+    using std::integral_constant;
+    return c.d == 0   ? run(integral_constant<int, 1>{}, integral_constant<int, 2>{}, integral_constant<int, 0>{})
+           : c.d == 1 ? run(integral_constant<int, 2>{}, integral_constant<int, 0>{}, integral_constant<int, 1>{})
+                      : run(integral_constant<int, 0>{}, integral_constant<int, 1>{}, integral_constant<int, 2>{});
 }
-// The points `which` names; returns the position in `which` of the first failure, or which.size().
-template <int U, int V, int D>
-std::size_t to_clip_at(const Double3& lo, const Double3& scale, std::span<const Double3> points,
-                       std::span<const std::uint32_t> which, Double4* out) {
-    for (std::size_t k = 0; k < which.size(); ++k)
-        if (!point_to_clip<U, V, D>(lo, scale, points[which[k]], out[which[k]])) return k;
-    return which.size();
+
+// Both overloads' checks of `out` and their error for a point that failed: its input, or the overflow.
+std::optional<Error> wrong_output(std::span<const Double3> points, std::span<Double4> out) {
+    if (out.size() == points.size()) return std::nullopt;
+    return Error{"ortho_view_to_clip: the output holds " + std::to_string(out.size()) + " points for " +
+                 std::to_string(points.size())};
+}
+Error bad_point(std::span<const Double3> points, std::size_t i) {
+    const Double3& p = points[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        return Error{"ortho_view_to_clip: point " + std::to_string(i) + " is not finite"};
+    return Error{"ortho_view_to_clip: point " + std::to_string(i) + " overflows the double range in clip space"};
 }
 
 }  // namespace
@@ -183,42 +199,23 @@ Result<std::size_t> ortho_view_to_clip(const OrthoView& view, std::span<const Do
 
 Result<std::size_t> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points,
                                        std::span<Double4> out) {
-    if (out.size() != points.size())
-        return Error{"ortho_view_to_clip: the output holds " + std::to_string(out.size()) + " points for " +
-                     std::to_string(points.size())};
-    const ClipParams c = clip_params(view);
-    const std::size_t bad = c.d == 0   ? to_clip<1, 2, 0>(c.lo, c.scale, points, out.data())
-                            : c.d == 1 ? to_clip<2, 0, 1>(c.lo, c.scale, points, out.data())
-                                       : to_clip<0, 1, 2>(c.lo, c.scale, points, out.data());
-    if (bad != points.size()) {
-        const Double3& p = points[bad];  // the first offence, named as before: its input, or the overflow
-        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-            return Error{"ortho_view_to_clip: point " + std::to_string(bad) + " is not finite"};
-        return Error{"ortho_view_to_clip: point " + std::to_string(bad) + " overflows the double range in clip space"};
-    }
+    if (std::optional<Error> e = wrong_output(points, out)) return *e;
+    const std::size_t bad =
+        to_clip(clip_params(view), points, points.size(), [](std::size_t k) { return k; }, out.data());
+    if (bad != points.size()) return bad_point(points, bad);  // the first offence
     return points.size();
 }
 
 Result<std::size_t> ortho_view_to_clip(const OrthoView& view, std::span<const Double3> points,
                                        std::span<const std::uint32_t> which, std::span<Double4> out) {
-    if (out.size() != points.size())
-        return Error{"ortho_view_to_clip: the output holds " + std::to_string(out.size()) + " points for " +
-                     std::to_string(points.size())};
+    if (std::optional<Error> e = wrong_output(points, out)) return *e;
     for (const std::uint32_t i : which)
         if (i >= points.size())
             return Error{"ortho_view_to_clip: index " + std::to_string(i) + " is out of range (" +
                          std::to_string(points.size()) + " points)"};
-    const ClipParams c = clip_params(view);
-    const std::size_t bad = c.d == 0   ? to_clip_at<1, 2, 0>(c.lo, c.scale, points, which, out.data())
-                            : c.d == 1 ? to_clip_at<2, 0, 1>(c.lo, c.scale, points, which, out.data())
-                                       : to_clip_at<0, 1, 2>(c.lo, c.scale, points, which, out.data());
-    if (bad != which.size()) {
-        const std::size_t at = which[bad];
-        const Double3& p = points[at];
-        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
-            return Error{"ortho_view_to_clip: point " + std::to_string(at) + " is not finite"};
-        return Error{"ortho_view_to_clip: point " + std::to_string(at) + " overflows the double range in clip space"};
-    }
+    const std::size_t bad =
+        to_clip(clip_params(view), points, which.size(), [&](std::size_t k) { return std::size_t{which[k]}; }, out.data());
+    if (bad != which.size()) return bad_point(points, which[bad]);
     return which.size();
 }
 
