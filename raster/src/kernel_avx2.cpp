@@ -289,4 +289,12 @@ bool kernel_avx2_available() {
 #endif
 }
 
+bool kernel_avx2_callable() {
+#if defined(RASTER_KERNEL_AVX2)
+    return kernel_avx2_available();
+#else
+    return true;  // the scalar build of the same entry points
+#endif
+}
+
 }  // namespace raster::detail

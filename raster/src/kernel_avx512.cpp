@@ -297,4 +297,12 @@ bool kernel_avx512_available() {
 #endif
 }
 
+bool kernel_avx512_callable() {
+#if defined(RASTER_KERNEL_AVX512)
+    return kernel_avx512_available();
+#else
+    return true;  // the scalar build of the same entry points
+#endif
+}
+
 }  // namespace raster::detail

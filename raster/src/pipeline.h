@@ -186,6 +186,12 @@ RectKernel select_rect_kernel_avx512(const DepthState& state, bool hiz);
 bool kernel_avx2_available();
 // True when the CPU has AVX-512F, AVX-512VL, AVX2 and FMA and this build has the AVX-512 kernel.
 bool kernel_avx512_available();
+// Whether raster_rect_avx2 / raster_rect_avx512 (and their _hiz forms) may be called on this CPU:
+// the SIMD build only where it is available, the scalar build of the same entry points (other
+// targets) always. The white-box tests call them directly; the executors pick through
+// select_rect_kernel, which never picks one that is not available.
+bool kernel_avx2_callable();
+bool kernel_avx512_callable();
 // False when CULLIDE_RASTER_NO_AVX512 keeps the AVX2 kernel where AVX-512 is available (read once).
 bool avx512_allowed_by_environment();
 // The HiZ block scan of the AVX2 kernel (8-pixel rows in one register; the scalar loop otherwise),
