@@ -15,8 +15,12 @@
 //   D24: cvtps2dq(z * 16777215)          (MXCSR round-to-nearest-even, as lrint)
 //   D16: bits(z * (65535/65536) + 128) & 0xffff
 //   D32F: compare as floats with the ordered/unordered predicate equal to C++'s operator
-// Stores are masked (maskstore) on partial chunks and blended on full ones, never touching a pixel
-// outside the span, so tiles on other threads are never read or written.
+// Partial chunks are read and written whole (plain load, blend, store: the lanes outside the span
+// get their own values back) when the 8 pixels lie in the rectangle's column group of kHizTile
+// (pipeline.h: the caller owns it), masked (maskload / maskstore) only where they would cross into
+// the next group or past the row's end; full chunks are blended. So tiles on other threads are
+// never read or written. A masked store of 8 lanes was the costliest instruction of the writing
+// kernel on AMD Zen 3 (perf, Q-CULLIDE-GL's passes at 1024^2).
 // Block-level trivial reject / accept: the three edge functions are evaluated at the four corner
 // pixel centres of the rectangle (a linear function takes its extremes at corners): an edge <= 0 at
 // all four rejects the whole rectangle; an edge > 0 at all four is dropped from the span work
@@ -105,30 +109,39 @@ inline __m256 lane_x8(int px) {
 inline __m256 plane_x8(const Plane8& p, __m256 fx) { return _mm256_fmadd_ps(p.dzdx, fx, p.z0); }
 
 // Depth test (and write) of the 8 pixels px..px+7 of `row` at row centre fy; `cover` marks the
-// pixels to process (full: all 8, plain load and blended store). Returns the passing-lane bits.
+// pixels to process (full: all 8). `whole`: the 8 pixels may be read and rewritten (own_chunk;
+// true when full), so a plain load and a blended store serve a partial chunk too. Returns the
+// passing-lane bits.
 // zx: plane_x8 of the 8 pixels, computed once per column of chunks by callers that visit it in many rows.
 template <DepthFormat Fmt, DepthFunc F, bool Write>
-inline unsigned chunk8(const Plane8& plane, std::uint32_t* row, int px, __m256 fy, __m256i cover, bool full,
+inline unsigned chunk8(const Plane8& plane, std::uint32_t* row, int px, __m256 fy, __m256i cover, bool whole,
                        __m256 zx) {
     __m256 z = _mm256_fmadd_ps(plane.dzdy, fy, zx);
     z = _mm256_max_ps(z, _mm256_setzero_ps());
     z = _mm256_min_ps(z, _mm256_set1_ps(1.0f));
     const __m256i incoming = encode8<Fmt>(z);
     std::uint32_t* p = row + px;
-    const __m256i stored = full ? _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p))
-                                : _mm256_maskload_epi32(reinterpret_cast<const int*>(p), cover);
+    const __m256i stored = whole ? _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p))
+                                 : _mm256_maskload_epi32(reinterpret_cast<const int*>(p), cover);
     const __m256i pass = _mm256_and_si256(pass8<Fmt, F>(incoming, stored), cover);
     const unsigned bits = lanes(pass);
     if constexpr (Write) {
-        // A full chunk is stored whether or not a lane passed (its pixels are this rectangle's,
-        // unchanged ones rewritten with their own value): the pass/fail pattern of writing draws
-        // is data, and a branch on it mispredicted (perf, cylinders frame).
-        if (full)
+        // A whole chunk is stored whether or not a lane passed (unchanged pixels rewritten with
+        // their own value): the pass/fail pattern of writing draws is data, and a branch on it
+        // mispredicted (perf, cylinders frame).
+        if (whole)
             _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), _mm256_blendv_epi8(stored, incoming, pass));
         else if (bits != 0)
             _mm256_maskstore_epi32(reinterpret_cast<int*>(p), pass, incoming);
     }
     return bits;
+}
+
+// Whether the chunk px..px+7 of a row of `stride` pixels lies in one column group of kHizTile and
+// inside the row: then it is in the group of the rectangle it meets, which the caller owns
+// (pipeline.h, RectKernel), and may be read and written whole.
+inline bool own_chunk(int px, int stride) {
+    return (px & (kHizTile - 1)) <= kHizTile - 8 && px + 8 <= stride;
 }
 
 constexpr int kNarrow = 16;  // rectangles narrower than this take the per-chunk edge path when it fits
@@ -147,12 +160,14 @@ std::uint64_t narrow_rows(const SetupTri& t, DepthRows depth, PixelRect rect, co
     const Plane8 plane(t);
     __m256i e[Columns][3], in_rect[Columns], step_y[3];
     __m256 zx[Columns];
+    bool own[Columns];
     #pragma GCC unroll 3
     for (int i = 0; i < 3; ++i) step_y[i] = _mm256_set1_epi32(static_cast<std::int32_t>(sy[i]));
     #pragma GCC unroll 2
     for (int k = 0; k < Columns; ++k) {
         const int px = rx0 + 8 * k;
         in_rect[k] = _mm256_cmpgt_epi32(_mm256_set1_epi32(rx1 - px + 1), iota);
+        own[k] = own_chunk(px, depth.stride);
         zx[k] = plane_x8(plane, lane_x8(px));
         #pragma GCC unroll 3
         for (int i = 0; i < 3; ++i) {
@@ -176,7 +191,7 @@ std::uint64_t narrow_rows(const SetupTri& t, DepthRows depth, PixelRect rect, co
             const unsigned m = lanes(cover);
             if (m == 0) continue;
             passed += static_cast<unsigned>(
-                std::popcount(chunk8<Fmt, F, Write>(plane, row, rx0 + 8 * k, fy, cover, m == 0xffu, zx[k])));
+                std::popcount(chunk8<Fmt, F, Write>(plane, row, rx0 + 8 * k, fy, cover, m == 0xffu || own[k], zx[k])));
         }
         if (stop_at_first && passed != 0) return passed;
     }
@@ -213,7 +228,8 @@ std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, b
             passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(plane, row, px, fy, all, true, plane_x8(plane, fx))));
         if (px <= ihi) {
             const __m256i cover = _mm256_cmpgt_epi32(_mm256_set1_epi32(ihi - px + 1), iota);
-            passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(plane, row, px, fy, cover, false, plane_x8(plane, fx))));
+            passed += static_cast<unsigned>(std::popcount(
+                chunk8<Fmt, F, Write>(plane, row, px, fy, cover, own_chunk(px, depth.stride), plane_x8(plane, fx))));
         }
         if (stop_at_first && passed != 0) return passed;
     }

@@ -100,6 +100,10 @@ inline void setup_range(const FrontEndParams& params, std::span<const Float4> ve
 // "0" (CULLIDE_RASTER_NO_AVX512 likewise keeps AVX2); bit-identical results.
 // stop_at_first: the caller only needs to know whether any sample passes (an any-samples query
 // with the depth mask off): the kernel may return any count >= 1 as soon as one sample passed.
+// Ownership: `rect` lies in one column group of kHizTile pixels (columns [64k, 64k + 63]) of the
+// target or the caller runs alone, and no other thread reads or writes those pixels of rect's rows
+// during the call: a kernel may read the group's pixels there and rewrite them with the values they
+// hold (the AVX2 kernel does, instead of masked stores). The tiled executor's tasks own their tiles.
 std::uint64_t raster_rect(const SetupTri& tri, const DepthState& state, DepthRows depth, PixelRect rect,
                           bool allow_simd, bool stop_at_first = false);
 std::uint64_t raster_rect_portable(const SetupTri& tri, const DepthState& state, DepthRows depth,
