@@ -19,6 +19,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "orient_plane.h"
+
 namespace cullide {
 namespace {
 
@@ -255,8 +257,9 @@ int orient3d_exact(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
 // only trust the filter when P_computed >= 2^-600; then those absolute errors (a few dozen times
 // 2^-1075) are far below the slack u * P, and the bound still holds. Otherwise: exact path.
 constexpr double kOrient2dBound = 5.0 * kEps;
-constexpr double kOrient3dBound = 9.0 * kEps;
-constexpr double kFilterMinPermanent = 0x1p-600;
+using detail::kOrient3dBound;       // 9 * kEps (orient_plane.h, which filters with it too)
+using detail::kFilterMinPermanent;  // 2^-600
+static_assert(kOrient3dBound == 9.0 * kEps);
 
 // ---- exact small-span stage (orient3d) ------------------------------------------------------------
 //

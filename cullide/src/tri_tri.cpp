@@ -22,6 +22,7 @@
 #include <utility>
 
 #include "cullide/predicates.h"
+#include "orient_plane.h"
 
 namespace cullide {
 namespace {
@@ -190,11 +191,14 @@ template <bool kRelation>
 TriRelation relate(const Vec3& a0, const Vec3& a1, const Vec3& a2, const Vec3& b0, const Vec3& b1,
                    const Vec3& b2) {
     // Signs of A's vertices against B's plane; all of one strict sign: separated by that plane.
-    const std::array<int, 3> sa{orient3d(b0, b1, b2, a0), orient3d(b0, b1, b2, a1), orient3d(b0, b1, b2, a2)};
+    // (orient3d(b0, b1, b2, .), with the plane's minors once: detail::Orient3dPlane.)
+    const detail::Orient3dPlane plane_b(b0, b1, b2);
+    const std::array<int, 3> sa{plane_b(a0), plane_b(a1), plane_b(a2)};
     if ((sa[0] > 0 && sa[1] > 0 && sa[2] > 0) || (sa[0] < 0 && sa[1] < 0 && sa[2] < 0)) {
         return TriRelation::Disjoint;
     }
-    const std::array<int, 3> sb{orient3d(a0, a1, a2, b0), orient3d(a0, a1, a2, b1), orient3d(a0, a1, a2, b2)};
+    const detail::Orient3dPlane plane_a(a0, a1, a2);
+    const std::array<int, 3> sb{plane_a(b0), plane_a(b1), plane_a(b2)};
     if ((sb[0] > 0 && sb[1] > 0 && sb[2] > 0) || (sb[0] < 0 && sb[1] < 0 && sb[2] < 0)) {
         return TriRelation::Disjoint;
     }

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "cullide/predicates.h"
+#include "orient_plane.h"
 #include "rational_tri_tri.h"
 #include "test_rng.h"
 
@@ -210,4 +211,69 @@ TEST_CASE("both predicates are exact across the whole stated range, magnitudes 2
     CHECK_FALSE(cullide::predicate_coordinate_ok(0x1p-301));
     CHECK_FALSE(cullide::predicate_coordinate_ok(std::numeric_limits<double>::quiet_NaN()));
     CHECK_FALSE(cullide::predicate_coordinate_ok(std::numeric_limits<double>::infinity()));
+}
+
+TEST_CASE("Orient3dPlane gives orient3d's exact sign for every point: near the plane, on grids, across the range") {
+    // cullide/src/orient_plane.h: the plane's minors once, orient3d's bound, orient3d where the
+    // filter does not decide. Against the rational sign on the inputs where the filter is tested
+    // hardest: points a few ulps off the plane (at tiny and huge scales and far from the origin),
+    // exactly coplanar integer grids, degenerate planes (repeated or collinear corners: a zero
+    // normal), and magnitudes across the whole range mixed.
+    Rng rng{25};
+    long wrong = 0, checked = 0, signs[3] = {0, 0, 0};
+    const auto check = [&](const Vec3& a, const Vec3& b, const Vec3& c, const Vec3* ds, int count) {
+        const cullide::detail::Orient3dPlane plane(a, b, c);
+        for (int i = 0; i < count; ++i) {
+            const int want = cullide::test::rational_orient3d(a, b, c, ds[i]);
+            const int got = plane(ds[i]);
+            wrong += got != want;
+            ++signs[want + 1];
+            ++checked;
+            if (got != want && wrong < 5) FAIL_CHECK("Orient3dPlane wrong at check " << checked);
+        }
+    };
+    for (int n = 0; n < 40000; ++n) {  // a few ulps off the plane
+        const int kind = n % 4;
+        const double s = kind == 1 ? 0x1p-100 : (kind == 2 ? 0x1p100 : 1.0);
+        const Vec3 offset = kind == 3 ? Vec3{1e15 * rng.sym(), 1e12 * rng.sym(), 1e9 * rng.sym()} : Vec3{};
+        const Vec3 a = offset + s * rng.sym3(), b = offset + s * rng.sym3(), c = offset + s * rng.sym3();
+        Vec3 ds[3];
+        for (Vec3& d : ds) {
+            const double u = rng.unit() * 2 - 0.5, v = rng.unit() * 2 - 0.5;
+            d = a + u * (b - a) + v * (c - a);
+            for (int k = 0; k < 3; ++k) d[k] = ulps(d[k], rng.range(-1, 1));
+        }
+        check(a, b, c, ds, 3);
+    }
+    for (int n = 0; n < 20000; ++n) {  // integer grids: coplanar, repeated and collinear corners
+        const Vec3 o{double(rng.range(-1000, 1000)), double(rng.range(-1000, 1000)), double(rng.range(-1000, 1000))};
+        const Vec3 e1{double(rng.range(-9, 9)), double(rng.range(-9, 9)), double(rng.range(-9, 9))};
+        const Vec3 e2{double(rng.range(-9, 9)), double(rng.range(-9, 9)), double(rng.range(-9, 9))};
+        const auto at = [&](int i, int j) { return o + double(i) * e1 + double(j) * e2; };
+        // n % 5 == 0: b repeated as c; == 1: three corners on one line; else a random grid plane.
+        const Vec3 a = n % 5 == 1 ? at(1, 0) : at(0, 0);
+        const Vec3 b = n % 5 == 1 ? at(3, 0) : at(rng.range(-5, 5), rng.range(-5, 5));
+        const Vec3 c = n % 5 == 0 ? b : (n % 5 == 1 ? at(2, 0) : at(rng.range(-5, 5), rng.range(-5, 5)));
+        const Vec3 ds[3] = {at(rng.range(-5, 5), rng.range(-5, 5)),
+                            at(rng.range(-5, 5), rng.range(-5, 5)) + Vec3{0.0, 0.0, double(rng.range(-1, 1))},
+                            a};
+        check(a, b, c, ds, 3);
+    }
+    for (int n = 0; n < 20000; ++n) {  // magnitudes 2^-300 .. 2^300 from a small pool
+        double pool[4];
+        for (double& p : pool) p = (rng.range(0, 5) == 0) ? 0.0 : wide(rng, -300, 298);
+        const auto pick = [&]() { return pool[rng.range(0, 3)]; };
+        Vec3 q[6];
+        for (Vec3& v : q) {
+            const double x = pick();
+            const double y = pick();
+            v = {x, y, pick()};
+        }
+        check(q[0], q[1], q[2], q + 3, 3);
+    }
+    CHECK(wrong == 0);
+    CHECK(checked == 240000);
+    CHECK(signs[0] > 1000);
+    CHECK(signs[1] > 1000);
+    CHECK(signs[2] > 1000);
 }
