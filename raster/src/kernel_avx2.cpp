@@ -139,7 +139,7 @@ inline unsigned chunk8(const Plane8& plane, std::uint32_t* row, int px, __m256 f
 
 // Whether the chunk px..px+7 of a row of `stride` pixels lies in one column group of kHizTile and
 // inside the row: then it is in the group of the rectangle it meets, which the caller owns
-// (pipeline.h, RectKernel), and may be read and written whole.
+// (pipeline.h, at raster_rect), and may be read and written whole.
 inline bool own_chunk(int px, int stride) {
     return (px & (kHizTile - 1)) <= kHizTile - 8 && px + 8 <= stride;
 }
