@@ -20,7 +20,8 @@ inline constexpr double kFilterMinPermanent = 0x1p-600;  // below it the filter 
 // most 8 times (the differences of its three factors, two products, the minor's subtraction, two
 // additions) and the permanent is evaluated the same way from the same rounded differences, so
 // orient3d's bound C = 9u holds unchanged (predicates.cpp). Where it does not decide, orient3d
-// itself answers. So the sign is orient3d's, exactly, for every d. Triangle-triangle tests ask
+// itself answers. So the sign is orient3d's, exactly, for every d. The plane keeps references to
+// its corners: it lives while they do (a local of the test that holds them). Triangle-triangle tests ask
 // three points against each triangle's plane (tri_tri.cpp): orient3d was 22% of a 1-thread tori
 // frame of `exact` (perf, session 25).
 class Orient3dPlane {
@@ -53,7 +54,9 @@ public:
     }
 
 private:
-    Vec3 a_, b_, c_;
+    const Vec3& a_;
+    const Vec3& b_;
+    const Vec3& c_;
     double nx_, ny_, nz_;  // u x v, rounded as above
     double mx_, my_, mz_;  // the magnitudes of its two products per component
 };
