@@ -21,9 +21,9 @@ inline constexpr double kFilterMinPermanent = 0x1p-600;  // below it the filter 
 // additions) and the permanent is evaluated the same way from the same rounded differences, so
 // orient3d's bound C = 9u holds unchanged (predicates.cpp). Where it does not decide, orient3d
 // itself answers. So the sign is orient3d's, exactly, for every d. The plane keeps references to
-// its corners: it lives while they do (a local of the test that holds them). Triangle-triangle tests ask
-// three points against each triangle's plane (tri_tri.cpp): orient3d was 22% of a 1-thread tori
-// frame of `exact` (perf, session 25).
+// its corners: it lives while they do (a local of the test that holds them). Triangle-triangle
+// tests ask three points against each triangle's plane (tri_tri.cpp): orient3d was 22% of a
+// 1-thread tori frame of `exact` (perf, session 25).
 class Orient3dPlane {
 public:
     Orient3dPlane(const Vec3& a, const Vec3& b, const Vec3& c) : a_(a), b_(b), c_(c) {
