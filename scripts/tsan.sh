@@ -11,7 +11,8 @@
 #   short (default, CI): the programs that run 1, 2, 3 and 8 threads (raster tiles, spatial hash, ground
 #         truth, golden digests), their thread-count test cases only; and the exact-bounds visibility
 #         passes that split one target between threads (the fused pass's runs, Quick-CULLIDE's
-#         windowed passes), against their recorded forms
+#         windowed passes), against their recorded forms; and the spread-schedule cases, where
+#         threads of their own must run items (raster/detail/parallel.h), every pipeline method too
 #   full  every library and unit test, all unit tests
 #   CULLIDE_TSAN_BUILD  build folder (default build-tsan)
 set -euo pipefail
@@ -71,8 +72,9 @@ grep -q "^TBB_DIR:[A-Z]*=$tbb_dir\$" "$build/CMakeCache.txt" || {
 }
 if [ "$mode" = short ]; then
   cmake --build "$build" -j"$(nproc)" --target raster_threads_test spatialhash_api_test ground_truth_test \
-    golden_digest_test raster_visibility_test quick_cullide_test fused_visibility_test
-  select=(-R 'for 1, 2, 3 and 8 threads|are identical for 1, 2, 3 and 8|same for 1, 2, 3 and 8|Repeated runs|golden digests:|split between threads|WindowedPasses .each|native windowed passes|Fused and recorded R-CULLIDE')
+    golden_digest_test raster_visibility_test quick_cullide_test fused_visibility_test raster_parallel_test \
+    raster_simd_test cullide_pipeline_test
+  select=(-R 'for 1, 2, 3 and 8 threads|are identical for 1, 2, 3 and 8|same for 1, 2, 3 and 8|Repeated runs|golden digests:|split between threads|WindowedPasses .each|native windowed passes|Fused and recorded R-CULLIDE|spread schedule')
 else
   cmake --build "$build" -j"$(nproc)"
   select=(-L unit -LE slow)

@@ -3,6 +3,7 @@
 #include "raster/detail/parallel.h"
 
 #include <algorithm>
+#include <atomic>
 
 #if defined(CULLIDE_HAVE_TBB)
 #include <oneapi/tbb/blocked_range.h>
@@ -10,12 +11,23 @@
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
 
+#include <exception>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <system_error>
+#include <thread>
+#include <vector>
 #endif
 
 namespace raster::detail {
+
+namespace {
+std::atomic<bool> g_spread{false};
+}  // namespace
+
+void set_spread_schedule(bool on) { g_spread.store(on, std::memory_order_relaxed); }
+bool spread_schedule() { return g_spread.load(std::memory_order_relaxed); }
 
 int effective_threads(int threads) {
 #if defined(CULLIDE_HAVE_TBB)
@@ -44,12 +56,49 @@ oneapi::tbb::task_arena& arena_of(int workers) {
     return *a;
 }
 
+// The spread schedule (parallel.h): item i on lane i % k, lane 0 (the caller) ascending, the other
+// lanes on threads of their own, descending.
+void run_spread(std::size_t k, std::size_t n, void (*fn)(void*, std::size_t), void* ctx) {
+    std::vector<std::exception_ptr> errors(k);
+    const auto lane = [&](std::size_t t) {
+        try {
+            if (t == 0) {
+                for (std::size_t i = 0; i < n; i += k) fn(ctx, i);
+                return;
+            }
+            for (std::size_t i = t + (n - 1 - t) / k * k;; i -= k) {  // t < k <= n: at least one item
+                fn(ctx, i);
+                if (i < k) break;
+            }
+        } catch (...) {
+            errors[t] = std::current_exception();
+        }
+    };
+    std::vector<std::thread> helpers;
+    helpers.reserve(k - 1);
+    std::size_t started = 1;
+    try {
+        for (; started < k; ++started) helpers.emplace_back(lane, started);
+    } catch (const std::system_error&) {
+        // No thread to be had: the lanes left run here, after lane 0 (still every item once).
+    }
+    lane(0);
+    for (std::size_t t = started; t < k; ++t) lane(t);
+    for (std::thread& h : helpers) h.join();
+    for (const std::exception_ptr& e : errors)
+        if (e) std::rethrow_exception(e);
+}
+
 }  // namespace
 #endif
 
 void parallel_for_erased(int threads, std::size_t n, void (*fn)(void*, std::size_t), void* ctx) {
 #if defined(CULLIDE_HAVE_TBB)
     const int workers = effective_threads(threads);
+    if (workers > 1 && n > 1 && spread_schedule()) {
+        run_spread(std::min<std::size_t>({static_cast<std::size_t>(workers), n, 4}), n, fn, ctx);
+        return;
+    }
     if (workers > 1 && n > 1) {
         arena_of(workers).execute([&] {
             oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, n, 1),

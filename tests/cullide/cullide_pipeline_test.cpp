@@ -17,6 +17,7 @@
 #include "cullide/quick_cullide.h"
 #include "cullide/scenes.h"
 #include "pipeline_test_util.h"
+#include "raster/detail/parallel.h"
 #include "test_rng.h"
 
 namespace {
@@ -177,6 +178,60 @@ TEST_CASE("pairs and every PCS figure are the same for 1, 2, 3 and 8 threads") {
             for (std::size_t v = 0; v < r.stats.views.size(); ++v) {
                 CHECK(r.stats.views[v].items_after == one.stats.views[v].items_after);
                 CHECK(r.stats.views[v].queries == one.stats.views[v].queries);
+            }
+        }
+    }
+}
+
+// raster/detail/parallel.h's spread schedule: every parallel_for of raster and cullide hands items
+// to threads of their own, in descending order, so a job that reads the calling thread's state (a
+// thread_local named inside a job) shows here even where oneTBB would run every job on the caller.
+TEST_CASE("on the spread schedule every method gives the pairs and figures of one thread, self-collision too") {
+    cullide::SceneOptions so;
+    so.scale = 0.05;
+    struct Input {
+        const char* scene;
+        int frame;
+        bool self;
+    };
+    for (const Input in : {Input{"tori", 2, false}, Input{"cloth", 55, true}}) {
+        auto scene = cullide::make_scene(in.scene, so);
+        REQUIRE(scene.ok());
+        const cullide::Frame objects = scene.value()->frame(in.frame);
+        for (Method m : {Method::Exact, Method::Auto, Method::Cullide, Method::RCullide, Method::RCullideOffset,
+                         Method::QCullide, Method::QCullideGL}) {
+            if (in.self && (m == Method::Cullide || m == Method::RCullide || m == Method::RCullideOffset)) continue;
+            CAPTURE(in.scene);
+            CAPTURE(cullide::to_string(m));
+            cullide::RunOptions o;
+            o.method = m;
+            o.self = in.self;
+            o.resolution = 128;
+            o.threads = 1;
+            auto one = cullide::process_frame(objects, o);
+            REQUIRE(one.ok());
+            CHECK_FALSE(one.value().pairs.empty());
+            const raster::detail::SpreadScheduleScope schedule;
+            for (int threads : {2, 3}) {
+                CAPTURE(threads);
+                o.threads = threads;
+                auto r = cullide::process_frame(objects, o);
+                REQUIRE_MESSAGE(r.ok(), (r.ok() ? std::string() : r.error().message));
+                const cullide::FrameStats& a = r.value().stats;
+                const cullide::FrameStats& b = one.value().stats;
+                CHECK(r.value().pairs == one.value().pairs);
+                CHECK(a.queries == b.queries);
+                CHECK(a.triangles_rasterized == b.triangles_rasterized);
+                CHECK(a.exact_tests == b.exact_tests);
+                CHECK(a.candidate_triangles == b.candidate_triangles);
+                CHECK(a.pcs_boxes == b.pcs_boxes);
+                CHECK(a.pcs_subobjects == b.pcs_subobjects);
+                REQUIRE(a.views.size() == b.views.size());
+                for (std::size_t v = 0; v < a.views.size(); ++v) {
+                    CAPTURE(v);
+                    CHECK(a.views[v].items_after == b.views[v].items_after);
+                    CHECK(a.views[v].queries == b.views[v].queries);
+                }
             }
         }
     }

@@ -2,9 +2,13 @@
 // the parallel-for that raster and cullide share (raster/detail/parallel.h).
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <thread>
 #include <vector>
 
 #include "raster/detail/parallel.h"
@@ -34,6 +38,81 @@ TEST_CASE("parallel_for calls the body once per index for 0, 1, 2, 3 and 8 threa
             raster::detail::parallel_for(threads, n, [&](std::size_t i) { calls[i].fetch_add(1); });
             for (std::size_t i = 0; i < n; ++i) CHECK(calls[i].load() == 1);
         }
+    }
+}
+
+TEST_CASE("The spread schedule runs every item once, item i on lane i % k, the other lanes on threads of their own") {
+    CHECK_FALSE(raster::detail::spread_schedule());  // off unless a test turns it on
+    const std::thread::id caller = std::this_thread::get_id();
+    for (const int threads : {1, 2, 3, 8}) {
+        for (const std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{2}, std::size_t{7}, std::size_t{1000}}) {
+            CAPTURE(threads);
+            CAPTURE(n);
+            const raster::detail::SpreadScheduleScope schedule;
+            CHECK(raster::detail::spread_schedule());
+            std::vector<std::atomic<int>> calls(n);
+            for (auto& c : calls) c.store(0);
+            std::vector<std::thread::id> ran_on(n);
+            std::vector<std::size_t> step(n);  // the item's place in its thread's order
+            raster::detail::parallel_for(threads, n, [&](std::size_t i) {
+                calls[i].fetch_add(1);
+                ran_on[i] = std::this_thread::get_id();
+                thread_local std::size_t seen = 0;  // items this thread ran in this call (fresh threads start at 0)
+                step[i] = std::this_thread::get_id() == caller ? i : seen++;
+            });
+            for (std::size_t i = 0; i < n; ++i) CHECK(calls[i].load() == 1);
+#if defined(CULLIDE_TEST_HAVE_TBB)
+            const std::size_t k = std::min<std::size_t>({static_cast<std::size_t>(threads), n, 4});
+#else
+            const std::size_t k = 1;  // one worker without oneTBB: no spread
+#endif
+            for (std::size_t i = 0; i < n; ++i) {
+                CAPTURE(i);
+                if (k <= 1 || i % k == 0) {
+                    CHECK(ran_on[i] == caller);
+                    continue;
+                }
+                CHECK(ran_on[i] != caller);
+                // Each lane has a thread of its own, which runs its items from the last down.
+                if (i + k < n) {
+                    CHECK(ran_on[i + k] == ran_on[i]);
+                    CHECK(step[i + k] + 1 == step[i]);
+                }
+                if (i + 1 < n && (i + 1) % k != 0) CHECK(ran_on[i + 1] != ran_on[i]);
+            }
+        }
+    }
+    CHECK_FALSE(raster::detail::spread_schedule());  // each scope restored the setting
+}
+
+TEST_CASE("On the spread schedule an item's exception reaches the caller after every lane has finished") {
+    const raster::detail::SpreadScheduleScope schedule;
+    for (const std::size_t bad : {std::size_t{0}, std::size_t{5}, std::size_t{998}}) {
+        CAPTURE(bad);
+        std::vector<std::atomic<int>> calls(1000);
+        for (auto& c : calls) c.store(0);
+        bool thrown = false;
+        try {
+            raster::detail::parallel_for(3, calls.size(), [&](std::size_t i) {
+                calls[i].fetch_add(1);
+                if (i == bad) throw std::runtime_error("item " + std::to_string(i));
+            });
+        } catch (const std::runtime_error& e) {
+            thrown = true;
+            CHECK(std::string(e.what()) == "item " + std::to_string(bad));
+        }
+#if defined(CULLIDE_TEST_HAVE_TBB)
+        CHECK(thrown);
+        // The lanes without the bad item ran all of theirs; none ran an item twice.
+        for (std::size_t i = 0; i < calls.size(); ++i) {
+            CAPTURE(i);
+            CHECK(calls[i].load() <= 1);
+            if (i % 3 != bad % 3) CHECK(calls[i].load() == 1);
+        }
+#else
+        CHECK(thrown);  // serially: the loop stops at the bad item
+        CHECK(calls[bad].load() == 1);
+#endif
     }
 }
 

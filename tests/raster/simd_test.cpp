@@ -22,6 +22,7 @@
 #include "pipeline.h"
 #include "raster/raster.h"
 #include "scene_gen.h"
+#include "thread_runs.h"
 
 namespace {
 
@@ -194,7 +195,7 @@ TEST_CASE("rect_outside never rejects a rectangle with a covered pixel") {
     CHECK(rejected > 100);
 }
 
-TEST_CASE("execute with SIMD on (1, 2, 3, 8 threads) == execute_reference with SIMD off, every bit") {
+TEST_CASE("execute with SIMD on (1, 2, 3, 8 threads, spread schedule) == execute_reference with SIMD off, every bit") {
     raster_test::SplitMix64 rng(31337);
     const int sizes[][2] = {{64, 64}, {250, 170}, {333, 77}};
     for (const auto f : kFormats) {
@@ -210,10 +211,14 @@ TEST_CASE("execute with SIMD on (1, 2, 3, 8 threads) == execute_reference with S
                 REQUIRE(ref.clear(scene.clear_depth).ok());
                 auto want = raster::execute_reference(ref, scene.batch, raster::ExecuteOptions{1, false});
                 REQUIRE(want.ok());
-                for (const int threads : {1, 2, 3, 8}) {
+                for (const raster_test::ThreadRun run : raster_test::kThreadRuns) {
+                    const int threads = run.threads;
+                    const bool spread = run.spread;
                     CAPTURE(static_cast<int>(f));
                     CAPTURE(sz[0]);
                     CAPTURE(threads);
+                    CAPTURE(spread);
+                    const raster::detail::SpreadScheduleScope schedule(spread);
                     auto t = raster::DepthTarget::create(sz[0], sz[1], f).value();
                     REQUIRE(t.clear(scene.clear_depth).ok());
                     auto got = raster::execute(t, scene.batch, raster::ExecuteOptions{threads, true});

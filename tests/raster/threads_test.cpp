@@ -11,6 +11,7 @@
 
 #include "raster/raster.h"
 #include "scene_gen.h"
+#include "thread_runs.h"
 
 namespace {
 
@@ -24,7 +25,7 @@ std::uint64_t fnv1a(std::uint64_t h, std::uint64_t v) {
 
 }  // namespace
 
-TEST_CASE("The tiled executor matches the scalar reference for 1, 2, 3 and 8 threads") {
+TEST_CASE("The tiled executor matches the scalar reference for 1, 2, 3 and 8 threads, and on the spread schedule") {
     const raster::DepthFormat formats[] = {raster::DepthFormat::D16, raster::DepthFormat::D24,
                                            raster::DepthFormat::D32F};
     struct Size {
@@ -51,8 +52,12 @@ TEST_CASE("The tiled executor matches the scalar reference for 1, 2, 3 and 8 thr
                 REQUIRE(want.ok());
                 std::uint64_t covered = 0;
                 for (auto v : want.value()) covered += v;
-                for (const int threads : {1, 2, 3, 8}) {
+                for (const raster_test::ThreadRun run : raster_test::kThreadRuns) {
+                    const int threads = run.threads;
+                    const bool spread = run.spread;
                     CAPTURE(threads);
+                    CAPTURE(spread);
+                    const raster::detail::SpreadScheduleScope schedule(spread);
                     auto t = raster::DepthTarget::create(sz.w, sz.h, f);
                     REQUIRE(t.ok());
                     REQUIRE(t.value().clear(scene.clear_depth).ok());
@@ -278,9 +283,15 @@ TEST_CASE("clear_depth gives the buffer and counts of DepthTarget::clear before 
         }
         const std::vector<std::uint32_t> want_depth(ref.value().values().begin(), ref.value().values().end());
         const raster::CommandBatch* seq[3] = {&batches[0].batch, &batches[1].batch, &batches[2].batch};
-        for (const int threads : {1, 2, 3}) {
+        // 3 threads run the batches as one sequence, the others one execute per batch.
+        for (const raster_test::ThreadRun run : raster_test::kThreadRuns) {
+            const int threads = run.threads;
+            const bool spread = run.spread;
+            if (threads == 8) continue;
+            const raster::detail::SpreadScheduleScope schedule(spread);
             for (const bool with_written : {false, true}) {
                 CAPTURE(threads);
+                CAPTURE(spread);
                 CAPTURE(with_written);
                 auto t = raster::DepthTarget::create(o.width, o.height, format);
                 REQUIRE(t.ok());

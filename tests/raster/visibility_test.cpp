@@ -2,13 +2,15 @@
 // two recorded passes it replaces (raster/visibility.h): on random scenes of objects made of items
 // (including degenerate, flat, edge-on, out-of-volume and sub-pixel triangles, and objects covering
 // the same pixels at the same depth), for every depth format, several target sizes (one tile and
-// several, edges not on tile borders) and 1, 2, 3 and 8 threads, the per-item answer equals "one of
-// the item's two queries passed a sample" from raster::execute and raster::execute_reference.
+// several, edges not on tile borders) and 1, 2, 3 and 8 threads (and 2 and 3 on the spread
+// schedule, thread_runs.h), the per-item answer equals "one of the item's two queries passed a
+// sample" from raster::execute and raster::execute_reference.
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -16,6 +18,7 @@
 #include "raster/visibility.h"
 #include "recorded_visibility.h"
 #include "test_rng.h"
+#include "thread_runs.h"
 
 namespace {
 
@@ -113,8 +116,11 @@ TEST_CASE("The fused visibility pass gives the two recorded passes' answers, any
         CAPTURE(rep);
         const std::vector<std::uint8_t> want = recorded(s, w, h, f, 1, true);
         CHECK(recorded(s, w, h, f, 3, false) == want);
-        for (const int threads : {1, 2, 3, 8}) {
+        for (const raster_test::ThreadRun run : raster_test::kThreadRuns) {
+            const int threads = run.threads;
             CAPTURE(threads);
+            CAPTURE(run.spread);
+            const raster::detail::SpreadScheduleScope schedule(run.spread);
             auto got = pass.run(w, h, f, items_of(s), threads);
             REQUIRE_MESSAGE(got.ok(), (got.ok() ? std::string() : got.error().message));
             CHECK(got.value() == want);
@@ -146,8 +152,11 @@ TEST_CASE("The fused visibility pass split between threads (one tile, many small
         const int w = sizes[(rep / 3) % 3][0], h = sizes[(rep / 3) % 3][1];
         CAPTURE(rep);
         const std::vector<std::uint8_t> want = recorded(s, w, h, f, 1, true);
-        for (const int threads : {1, 2, 3, 8}) {
+        for (const raster_test::ThreadRun run : raster_test::kThreadRuns) {
+            const int threads = run.threads;
             CAPTURE(threads);
+            CAPTURE(run.spread);
+            const raster::detail::SpreadScheduleScope schedule(run.spread);
             auto got = pass.run(w, h, f, items_of(s), threads);
             REQUIRE_MESSAGE(got.ok(), (got.ok() ? std::string() : got.error().message));
             CHECK(got.value() == want);
@@ -244,8 +253,11 @@ TEST_CASE("The fused visibility pass: items alone in the view are skipped with t
         const int w = sizes[(rep / 3) % 3][0], h = sizes[(rep / 3) % 3][1];
         CAPTURE(rep);
         const std::vector<std::uint8_t> want = recorded(s, w, h, f, 1, true);
-        for (const int threads : {1, 2, 3, 8}) {
+        for (const raster_test::ThreadRun run : raster_test::kThreadRuns) {
+            const int threads = run.threads;
             CAPTURE(threads);
+            CAPTURE(run.spread);
+            const raster::detail::SpreadScheduleScope schedule(run.spread);
             raster::VisibilityPass pass;  // fresh: the pre-pass runs on a first call
             pass.set_presettle(false);    // (which would settle these items first on one tile)
             auto got = pass.run(w, h, f, items_of(s), threads);
@@ -262,7 +274,7 @@ TEST_CASE("The fused visibility pass: items alone in the view are skipped with t
     CHECK(visible > 100);
     CHECK(hidden > 100);
     CHECK(far_alone > 20);
-    CHECK(spared_runs == 18 * 4);  // every run found items alone
+    CHECK(spared_runs == 18 * std::size(raster_test::kThreadRuns));  // every run found items alone
 }
 
 TEST_CASE("The fused visibility pass: the pre-pass's history of one scene does not turn it off for another") {
@@ -499,8 +511,11 @@ TEST_CASE("The settling pre-pass gives the recorded answers, settling items and 
                                     rep % 4 == 0, 2.0 / w, 2.0 / h);
         CAPTURE(rep);
         const std::vector<std::uint8_t> want = recorded(s, w, h, f, 1, true);
-        for (const int threads : {1, 2, 3, 8}) {
+        for (const raster_test::ThreadRun run : raster_test::kThreadRuns) {
+            const int threads = run.threads;
             CAPTURE(threads);
+            CAPTURE(run.spread);
+            const raster::detail::SpreadScheduleScope schedule(run.spread);
             raster::VisibilityPass off;
             off.set_presettle(false);
             auto plain = off.run(w, h, f, items_of(s), threads);
