@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdlib>
+#include <cstring>
 
 #if defined(CULLIDE_HAVE_TBB)
 #include <oneapi/tbb/blocked_range.h>
@@ -23,11 +25,18 @@
 namespace raster::detail {
 
 namespace {
-std::atomic<bool> g_spread{false};
+// Made on first use (so no static initializer can see it unset): on when the environment says so.
+std::atomic<bool>& spread_flag() {
+    static std::atomic<bool> flag{[] {
+        const char* v = std::getenv("CULLIDE_SPREAD_SCHEDULE");
+        return v != nullptr && std::strcmp(v, "1") == 0;
+    }()};
+    return flag;
+}
 }  // namespace
 
-void set_spread_schedule(bool on) { g_spread.store(on, std::memory_order_relaxed); }
-bool spread_schedule() { return g_spread.load(std::memory_order_relaxed); }
+void set_spread_schedule(bool on) { spread_flag().store(on, std::memory_order_relaxed); }
+bool spread_schedule() { return spread_flag().load(std::memory_order_relaxed); }
 
 int effective_threads(int threads) {
 #if defined(CULLIDE_HAVE_TBB)

@@ -32,8 +32,9 @@ void parallel_for_erased(int threads, std::size_t n, void (*fn)(void*, std::size
 // in ascending order, k - 1 fresh std::threads each run theirs in descending order, all at once, and
 // the call returns after joining them (rethrowing the first lane's exception, in lane order). So
 // every item whose index is not a multiple of k runs on a thread that never ran one before, in an
-// order unlike the serial one. Process-wide; for tests only (each call starts threads). Without
-// oneTBB (one worker always) it has no effect.
+// order unlike the serial one. Process-wide; for tests only (each call starts threads). Off unless
+// the environment variable CULLIDE_SPREAD_SCHEDULE is 1 when it is first read (CI runs the whole
+// unit suite so once). Without oneTBB (one worker always) it has no effect.
 void set_spread_schedule(bool on);
 [[nodiscard]] bool spread_schedule();
 
