@@ -72,7 +72,7 @@ grep -q "^TBB_DIR:[A-Z]*=$tbb_dir\$" "$build/CMakeCache.txt" || {
 }
 if [ "$mode" = short ]; then
   cmake --build "$build" -j"$(nproc)" --target raster_threads_test spatialhash_api_test ground_truth_test \
-    golden_digest_test raster_visibility_test quick_cullide_test fused_visibility_test raster_parallel_test \
+    golden_digest_test raster_visibility_test quick_cullide_test fused_visibility_test raster_parallel_test spatialhash_stages_test \
     raster_simd_test cullide_pipeline_test
   select=(-R 'for 1, 2, 3 and 8 threads|are identical for 1, 2, 3 and 8|same for 1, 2, 3 and 8|Repeated runs|golden digests:|split between threads|WindowedPasses .each|native windowed passes|Fused and recorded R-CULLIDE|spread schedule')
 else

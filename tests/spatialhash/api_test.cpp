@@ -123,7 +123,7 @@ TEST_CASE("zero, one and two objects give the obvious answers") {
     }
 }
 
-TEST_CASE("results are identical for 1, 2, 3 and 8 threads and equal the reference") {
+TEST_CASE("results are identical for 1, 2, 3 and 8 threads (and on the spread schedule) and equal the reference") {
 #if defined(CULLIDE_HAVE_TBB)
     // Let TBB run 8 workers even on a 2-core machine, so that 3 and 8 threads really happen.
     tbb::global_control allow(tbb::global_control::max_allowed_parallelism, 8);
@@ -141,9 +141,12 @@ TEST_CASE("results are identical for 1, 2, 3 and 8 threads and equal the referen
     const std::vector<Pair> want = reference_pairs(boxes);
     MESSAGE("reference pairs: " << want.size() << ", digest " << digest(want));
     for (Method m : kMethods) {
-        for (unsigned threads : {1U, 2U, 3U, 8U}) {
+        for (const ThreadRun run : kThreadRuns) {
+            const unsigned threads = run.threads;
+            const SpreadScope spread(run.spread);
             CAPTURE(static_cast<int>(m));
             CAPTURE(threads);
+            CAPTURE(run.spread);
             auto r = spatialhash::find_pairs(std::span<const Box>(boxes), with(m, threads));
             REQUIRE(r.ok());
             CHECK(r.value().pairs.size() == want.size());

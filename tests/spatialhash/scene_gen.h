@@ -8,8 +8,31 @@
 #include <vector>
 
 #include "spatialhash/broad_phase.h"
+#include "spatialhash/detail/executor.h"
 
 namespace sh_test {
+
+// The executor's spread schedule (spatialhash/detail/executor.h) on for a scope when `on`; the
+// previous setting comes back at its end.
+class SpreadScope {
+   public:
+    explicit SpreadScope(bool on) : was_(spatialhash::detail::spread_schedule()) {
+        if (on) spatialhash::detail::set_spread_schedule(true);
+    }
+    ~SpreadScope() { spatialhash::detail::set_spread_schedule(was_); }
+    SpreadScope(const SpreadScope&) = delete;
+    SpreadScope& operator=(const SpreadScope&) = delete;
+
+   private:
+    bool was_;
+};
+
+// Thread counts of the thread tests: oneTBB's schedule, then 2 and 3 on the spread schedule.
+struct ThreadRun {
+    unsigned threads;
+    bool spread;
+};
+inline constexpr ThreadRun kThreadRuns[] = {{1, false}, {2, false}, {3, false}, {8, false}, {2, true}, {3, true}};
 
 using spatialhash::Box;
 using spatialhash::Pair;

@@ -2,9 +2,11 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <map>
 #include <set>
+#include <thread>
 #include <tuple>
 #include <vector>
 
@@ -23,9 +25,37 @@ std::vector<d::BoundingSphere> spheres_of(const std::vector<Sphere>& s) {
 
 }  // namespace
 
+TEST_CASE("The executor's spread schedule runs every item once, lanes other than 0 on threads of their own") {
+    const std::thread::id caller = std::this_thread::get_id();
+    for (unsigned threads : {1U, 2U, 3U, 8U}) {
+        for (std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{2}, std::size_t{9}, std::size_t{500}}) {
+            CAPTURE(threads);
+            CAPTURE(n);
+            const SpreadScope spread(true);
+            d::Executor ex(threads);
+            std::vector<std::atomic<int>> calls(n);
+            for (auto& c : calls) c.store(0);
+            std::vector<std::thread::id> ran_on(n);
+            ex.for_each(n, [&](std::size_t i) {
+                calls[i].fetch_add(1);
+                ran_on[i] = std::this_thread::get_id();
+            });
+            const std::size_t k = ex.concurrency() > 1 ? std::min<std::size_t>({ex.concurrency(), n, 4}) : 1;
+            for (std::size_t i = 0; i < n; ++i) {
+                CAPTURE(i);
+                CHECK(calls[i].load() == 1);
+                if (k <= 1 || i % k == 0) CHECK(ran_on[i] == caller);
+                else CHECK(ran_on[i] != caller);
+            }
+        }
+    }
+}
+
 TEST_CASE("radix sort is stable and equals std::stable_sort on the low key bits") {
     Rng rng(11);
-    for (unsigned threads : {1U, 2U, 3U, 8U}) {
+    for (const ThreadRun run : kThreadRuns) {
+        const unsigned threads = run.threads;
+        const SpreadScope spread(run.spread);
         d::Executor ex(threads);
         for (int round = 0; round < 6; ++round) {
             const std::size_t n = round == 0 ? 0 : (round == 1 ? 1 : 1000 + rng.below(70000));
@@ -49,6 +79,7 @@ TEST_CASE("radix sort is stable and equals std::stable_sort on the low key bits"
             }
             d::radix_sort(keys, values, key_bits, ex);
             CAPTURE(threads);
+            CAPTURE(run.spread);
             CAPTURE(n);
             CAPTURE(key_bits);
             CHECK(keys == want_keys);
@@ -292,7 +323,10 @@ TEST_CASE("build_cell_entries equals build_cell_ids without its sentinels, for a
             s.push_back(Sphere{{rng.range(-20, 20), rng.range(-20, 20), rng.range(0, 9)}, r});
         }
         const auto bs = spheres_of(s);
-        for (unsigned threads : {1U, 2U, 3U}) {
+        for (const ThreadRun run : kThreadRuns) {
+            const unsigned threads = run.threads;
+            if (threads == 8) continue;
+            const SpreadScope spread(run.spread);
             d::Executor ex(threads);
             auto planned = d::plan_grid(bs, 0.0, ex);
             REQUIRE(planned.ok());
@@ -301,6 +335,7 @@ TEST_CASE("build_cell_entries equals build_cell_ids without its sentinels, for a
             const d::CellIdArray got = d::build_cell_entries(bs, planned.value(), ex);
             CAPTURE(round);
             CAPTURE(threads);
+            CAPTURE(run.spread);
             CHECK(got.cell_ids == want.cell_ids);
             CHECK(got.objects == want.objects);
             CHECK(got.control == want.control);

@@ -23,6 +23,15 @@ inline constexpr std::size_t kChunk = std::size_t{1} << 14;
     return (n + chunk - 1) / chunk;
 }
 
+// The spread schedule, a testing aid (the twin of raster/detail/parallel.h's, which spatialhash may not
+// include): while on, an Executor of k > 1 threads runs item i on lane i % min(k, count, 4), lane 0
+// on the caller in ascending order and every other lane on a fresh std::thread in descending order,
+// so a test of thread counts sees workers really run items (oneTBB may keep a small input on the
+// caller). Off unless set, or the environment variable CULLIDE_SPREAD_SCHEDULE is 1 when first read.
+// No effect without oneTBB.
+void set_spread_schedule(bool on);
+[[nodiscard]] bool spread_schedule();
+
 class Executor {
    public:
     // threads = 0: all hardware threads. 1: serial in the calling thread.
