@@ -12,7 +12,8 @@
 #         truth, golden digests), their thread-count test cases only; and the exact-bounds visibility
 #         passes that split one target between threads (the fused pass's runs, Quick-CULLIDE's
 #         windowed passes), against their recorded forms; and the spread-schedule cases, where
-#         threads of their own must run items (raster/detail/parallel.h), every pipeline method too
+#         threads of their own must run items (raster/detail/parallel.h, spatialhash's executor),
+#         every pipeline method too
 #   full  every library and unit test, all unit tests
 #   CULLIDE_TSAN_BUILD  build folder (default build-tsan)
 set -euo pipefail

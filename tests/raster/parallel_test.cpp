@@ -49,7 +49,8 @@ TEST_CASE("The spread schedule runs every item once, item i on lane i % k, the o
     CHECK(raster::detail::spread_schedule() == from_env);
     const std::thread::id caller = std::this_thread::get_id();
     for (const int threads : {1, 2, 3, 8}) {
-        for (const std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{2}, std::size_t{7}, std::size_t{1000}}) {
+        for (const std::size_t n :
+             {std::size_t{0}, std::size_t{1}, std::size_t{2}, std::size_t{7}, std::size_t{1000}}) {
             CAPTURE(threads);
             CAPTURE(n);
             const raster::detail::SpreadScheduleScope schedule;
@@ -61,7 +62,8 @@ TEST_CASE("The spread schedule runs every item once, item i on lane i % k, the o
             raster::detail::parallel_for(threads, n, [&](std::size_t i) {
                 calls[i].fetch_add(1);
                 ran_on[i] = std::this_thread::get_id();
-                thread_local std::size_t seen = 0;  // items this thread ran in this call (fresh threads start at 0)
+                // Items this thread ran in this call (a helper is a fresh thread: it starts at 0).
+                thread_local std::size_t seen = 0;
                 step[i] = std::this_thread::get_id() == caller ? i : seen++;
             });
             for (std::size_t i = 0; i < n; ++i) CHECK(calls[i].load() == 1);

@@ -13,6 +13,7 @@ struct ThreadRun {
     int threads;
     bool spread;
 };
-inline constexpr ThreadRun kThreadRuns[] = {{1, false}, {2, false}, {3, false}, {8, false}, {2, true}, {3, true}};
+inline constexpr ThreadRun kThreadRuns[] = {{1, false}, {2, false}, {3, false},
+                                            {8, false}, {2, true},  {3, true}};
 
 }  // namespace raster_test

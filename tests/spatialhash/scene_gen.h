@@ -32,7 +32,8 @@ struct ThreadRun {
     unsigned threads;
     bool spread;
 };
-inline constexpr ThreadRun kThreadRuns[] = {{1, false}, {2, false}, {3, false}, {8, false}, {2, true}, {3, true}};
+inline constexpr ThreadRun kThreadRuns[] = {{1, false}, {2, false}, {3, false},
+                                            {8, false}, {2, true},  {3, true}};
 
 using spatialhash::Box;
 using spatialhash::Pair;

@@ -28,7 +28,8 @@ std::vector<d::BoundingSphere> spheres_of(const std::vector<Sphere>& s) {
 TEST_CASE("The executor's spread schedule runs every item once, lanes other than 0 on threads of their own") {
     const std::thread::id caller = std::this_thread::get_id();
     for (unsigned threads : {1U, 2U, 3U, 8U}) {
-        for (std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{2}, std::size_t{9}, std::size_t{500}}) {
+        for (std::size_t n :
+             {std::size_t{0}, std::size_t{1}, std::size_t{2}, std::size_t{9}, std::size_t{500}}) {
             CAPTURE(threads);
             CAPTURE(n);
             const SpreadScope spread(true);

@@ -24,23 +24,25 @@ namespace raster::detail {
 // are done; serially in the calling thread when that is 1 or n <= 1.
 void parallel_for_erased(int threads, std::size_t n, void (*fn)(void*, std::size_t), void* ctx);
 
-// A testing aid for the rule above, which oneTBB alone cannot check: on a small input it often runs
-// every item on the calling thread, so a body that reads the wrong thread's state (a thread_local
-// named inside a job is the job thread's, not the caller's) passed the thread suites and crashed
-// `cullide bench` (session 26). While the spread schedule is on, a parallel_for that would use
-// k = min(workers, n, 4) > 1 threads runs item i on thread i % k instead: the caller runs its items
-// in ascending order, k - 1 fresh std::threads each run theirs in descending order, all at once, and
-// the call returns after joining them (rethrowing the first lane's exception, in lane order). So
-// every item whose index is not a multiple of k runs on a thread that never ran one before, in an
-// order unlike the serial one. Process-wide; for tests only (each call starts threads). Off unless
-// the environment variable CULLIDE_SPREAD_SCHEDULE is 1 when it is first read (CI runs the whole
-// unit suite so once). Without oneTBB (one worker always) it has no effect.
+// A testing aid for the rule above, which oneTBB alone cannot check: it may run every item of a
+// call on the calling thread (in up to half the calls of some thread suites on a 2-core machine),
+// and then a body that reads the wrong thread's state (a thread_local named inside a job is the job
+// thread's, not the caller's) or depends on the items' order passes. While the spread schedule is
+// on, a parallel_for that would use k = min(workers, n, 4) > 1 threads runs item i on thread i % k
+// instead: the caller runs its items in ascending order, k - 1 fresh std::threads each run theirs
+// in descending order, all at once, and the call returns after joining them (rethrowing the first
+// lane's exception, in lane order). So every item whose index is not a multiple of k runs on a
+// thread that never ran one before, in an order unlike the serial one. Process-wide; for tests only
+// (each call starts threads). Off unless the environment variable CULLIDE_SPREAD_SCHEDULE is 1 when
+// it is first read (CI runs the whole unit suite so once). Without oneTBB (one worker always) it
+// has no effect.
 void set_spread_schedule(bool on);
 [[nodiscard]] bool spread_schedule();
 
-// Turns the spread schedule on for a scope (when `on`) and restores the previous setting when it ends.
+// Turns the spread schedule on for a scope (when `on`) and restores the previous setting when it
+// ends.
 class SpreadScheduleScope {
-public:
+   public:
     explicit SpreadScheduleScope(bool on = true) : was_(spread_schedule()) {
         if (on) set_spread_schedule(true);
     }
@@ -48,7 +50,7 @@ public:
     SpreadScheduleScope(const SpreadScheduleScope&) = delete;
     SpreadScheduleScope& operator=(const SpreadScheduleScope&) = delete;
 
-private:
+   private:
     bool was_;
 };
 
