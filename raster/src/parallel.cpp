@@ -104,11 +104,11 @@ void run_spread(std::size_t k, std::size_t n, void (*fn)(void*, std::size_t), vo
 void parallel_for_erased(int threads, std::size_t n, void (*fn)(void*, std::size_t), void* ctx) {
 #if defined(CULLIDE_HAVE_TBB)
     const int workers = effective_threads(threads);
-    if (workers > 1 && n > 1 && spread_schedule()) {
-        run_spread(std::min<std::size_t>({static_cast<std::size_t>(workers), n, 4}), n, fn, ctx);
-        return;
-    }
     if (workers > 1 && n > 1) {
+        if (spread_schedule()) {
+            run_spread(std::min<std::size_t>({static_cast<std::size_t>(workers), n, 4}), n, fn, ctx);
+            return;
+        }
         arena_of(workers).execute([&] {
             oneapi::tbb::parallel_for(oneapi::tbb::blocked_range<std::size_t>(0, n, 1),
                                       [&](const oneapi::tbb::blocked_range<std::size_t>& r) {

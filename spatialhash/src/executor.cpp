@@ -96,11 +96,11 @@ Executor::~Executor() = default;
 
 void Executor::run(std::size_t count, void (*fn)(void*, std::size_t), void* ctx) {
 #if defined(CULLIDE_HAVE_TBB)
-    if (impl_ && count > 1 && spread_schedule()) {
-        run_spread(std::min<std::size_t>({static_cast<std::size_t>(concurrency_), count, 4}), count, fn, ctx);
-        return;
-    }
     if (impl_ && count > 1) {
+        if (spread_schedule()) {
+            run_spread(std::min<std::size_t>({static_cast<std::size_t>(concurrency_), count, 4}), count, fn, ctx);
+            return;
+        }
         impl_->arena.execute([&] {
             // grainsize 1: items are already chunks of kChunk elements.
             tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1),

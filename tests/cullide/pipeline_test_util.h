@@ -19,12 +19,14 @@ inline std::vector<cullide::TrianglePair> truth(const std::vector<cullide::Mesh>
 }
 
 inline cullide::FrameResult run(const std::vector<cullide::Mesh>& objects, cullide::Method m, int resolution,
-                                int threads = 2, cullide::BroadPhase bp = cullide::BroadPhase::None) {
+                                int threads = 2, cullide::BroadPhase bp = cullide::BroadPhase::None,
+                                bool self = false) {
     cullide::RunOptions o;
     o.method = m;
     o.resolution = resolution;
     o.threads = threads;
     o.broadphase = bp;
+    o.self = self;
     auto r = cullide::process_frame(objects, o);
     if (!r) FAIL(r.error().message);
     return r.value();

@@ -12,22 +12,10 @@
 
 namespace sh_test {
 
-// The executor's spread schedule (spatialhash/detail/executor.h) on for a scope when `on`; the
-// previous setting comes back at its end.
-class SpreadScope {
-   public:
-    explicit SpreadScope(bool on) : was_(spatialhash::detail::spread_schedule()) {
-        if (on) spatialhash::detail::set_spread_schedule(true);
-    }
-    ~SpreadScope() { spatialhash::detail::set_spread_schedule(was_); }
-    SpreadScope(const SpreadScope&) = delete;
-    SpreadScope& operator=(const SpreadScope&) = delete;
+using SpreadScope = spatialhash::detail::SpreadScheduleScope;
 
-   private:
-    bool was_;
-};
-
-// Thread counts of the thread tests: oneTBB's schedule, then 2 and 3 on the spread schedule.
+// Thread counts of the thread tests: oneTBB's schedule, then 2 and 3 on the spread schedule
+// (spatialhash/detail/executor.h).
 struct ThreadRun {
     unsigned threads;
     bool spread;

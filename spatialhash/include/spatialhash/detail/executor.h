@@ -32,6 +32,21 @@ inline constexpr std::size_t kChunk = std::size_t{1} << 14;
 void set_spread_schedule(bool on);
 [[nodiscard]] bool spread_schedule();
 
+// Turns the spread schedule on for a scope (when `on`) and restores the previous setting when it
+// ends.
+class SpreadScheduleScope {
+   public:
+    explicit SpreadScheduleScope(bool on = true) : was_(spread_schedule()) {
+        if (on) set_spread_schedule(true);
+    }
+    ~SpreadScheduleScope() { set_spread_schedule(was_); }
+    SpreadScheduleScope(const SpreadScheduleScope&) = delete;
+    SpreadScheduleScope& operator=(const SpreadScheduleScope&) = delete;
+
+   private:
+    bool was_;
+};
+
 class Executor {
    public:
     // threads = 0: all hardware threads. 1: serial in the calling thread.
