@@ -504,9 +504,16 @@ std::uint32_t float_order(float f) {
 }
 
 struct TriRef {
-    float lo[3], hi[3];     // the triangle's box, rounded outward
-    std::uint32_t pos = 0;  // position in its object
-    std::uint32_t low = 0;  // cell of the box's low corner, u | v << 16
+    // gather writes every field of a ref in place in its list: built in a local and pushed, its
+    // 4-byte field stores were read back by push_back's 16-byte loads before they had landed
+    // (store-forwarding stalls; push_back was 5% of a 1-thread `exact` frame, perf, most of it on
+    // those loads), and emplace_back() would zero the 32 bytes first. TriRef() stays trivial.
+    struct Uninitialized {};
+    TriRef() = default;
+    explicit TriRef(Uninitialized) {}  // NOLINT: every field is set by gather
+    float lo[3], hi[3];  // the triangle's box, rounded outward
+    std::uint32_t pos;   // position in its object
+    std::uint32_t low;   // cell of the box's low corner, u | v << 16
 };
 
 struct TriTask {
@@ -772,20 +779,24 @@ void gather(const TriTask& t, const ExactObject& o, const TriangleBoxes& boxes, 
                     if (!meets(fb) || !overlaps(o.triangle_boxes[p], t.common)) continue;
                     std::atomic_ref<unsigned char>(in_task[p]).store(1, std::memory_order_relaxed);
                 }
-                // The ref, pushed in place (a lambda call here was a third of the gather).
-                TriRef r;
+                // The ref, written in place in the list of the first slab its rows reach (a lambda
+                // call here was a third of the gather; a local copied in by push_back stalled:
+                // TriRef), then copied to the further ones.
+                const std::uint32_t low = low_cells(fb);
+                std::uint16_t s0 = 0, s1 = 0;
+                if (!one_slab) {
+                    s0 = t.row_slab[low >> 16];
+                    s1 = t.row_slab[t.gv.cell(static_cast<double>(fb.hi[v]))];
+                    if (s1 < s0) continue;  // no slab (never: cells and slabs are monotone)
+                }
+                TriRef& r = out[s0].emplace_back(TriRef::Uninitialized{});
                 for (int k = 0; k < 3; ++k) {
                     r.lo[k] = fb.lo[k];
                     r.hi[k] = fb.hi[k];
                 }
                 r.pos = p;
-                r.low = low_cells(fb);
-                if (one_slab) {
-                    out[0].push_back(r);
-                    continue;
-                }
-                const std::uint16_t s1 = t.row_slab[t.gv.cell(static_cast<double>(r.hi[v]))];
-                for (std::uint16_t s = t.row_slab[r.low >> 16]; s <= s1; ++s) out[s].push_back(r);
+                r.low = low;
+                for (std::uint16_t s = s0; s < s1;) out[++s].push_back(out[s0].back());
             }
         }
     };
