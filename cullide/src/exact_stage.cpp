@@ -511,9 +511,9 @@ struct TriRef {
     struct Uninitialized {};
     TriRef() = default;
     explicit TriRef(Uninitialized) {}  // NOLINT: every field is set by gather
-    float lo[3], hi[3];  // the triangle's box, rounded outward
-    std::uint32_t pos;   // position in its object
-    std::uint32_t low;   // cell of the box's low corner, u | v << 16
+    float lo[3], hi[3];                // the triangle's box, rounded outward
+    std::uint32_t pos;                 // position in its object
+    std::uint32_t low;                 // cell of the box's low corner, u | v << 16
 };
 
 struct TriTask {
