@@ -707,34 +707,23 @@ std::vector<ObjectGeometry> subobject_geometry(std::span<const Mesh> objects, st
     detail::parallel_chunks(threads, parts.size(), [&](std::size_t j) {
         ObjectGeometry& og = subs[parts[j].k];
         const Mesh& m = objects[active[og.active_index]];
-        // One pass: each triangle's box (triangle_bounds' bits: std::min / std::max of two keep the
-        // first of equal values, as of a list), stored field by field and folded into its
-        // sub-object's box as unite folds them (a triangle's box is never empty). Aabb values
-        // returned and copied were packed through the stack and read back before the stores had
-        // landed: this loop was 10% of a 1-thread cloth / rcullide frame with triangle_bounds
-        // called out of line, 20% with it inlined. A part starts at a multiple of `group`, so its
-        // items are counted on from first / group.
-        const Vec3* const pos = m.positions.data();
+        // One pass: each triangle's box, written in place (detail::triangle_box: an Aabb returned
+        // by triangle_bounds and copied in stalled store forwarding; this loop was 10% of a
+        // 1-thread cloth / rcullide frame), folded into its sub-object's box as unite folds them
+        // (a triangle's box is never empty). A part starts at a multiple of `group`, so its items
+        // are counted on from first / group.
         std::size_t item = parts[j].first / group;
         for (std::size_t first = parts[j].first; first < parts[j].last; first += group, ++item) {
             const std::size_t last = std::min(parts[j].last, first + group);
             double lx = 0, ly = 0, lz = 0, hx = 0, hy = 0, hz = 0;
             for (std::size_t t = first; t < last; ++t) {
-                const Tri& tri = m.triangles[t];
-                const Vec3& a = pos[tri[0]];
-                const Vec3& b = pos[tri[1]];
-                const Vec3& c = pos[tri[2]];
-                const double x0 = std::min(std::min(a.x, b.x), c.x), x1 = std::max(std::max(a.x, b.x), c.x);
-                const double y0 = std::min(std::min(a.y, b.y), c.y), y1 = std::max(std::max(a.y, b.y), c.y);
-                const double z0 = std::min(std::min(a.z, b.z), c.z), z1 = std::max(std::max(a.z, b.z), c.z);
                 Aabb& box = og.triangle_boxes[t];
-                box.lo.x = x0, box.lo.y = y0, box.lo.z = z0;
-                box.hi.x = x1, box.hi.y = y1, box.hi.z = z1;
+                detail::triangle_box(m, t, box);
                 if (t == first) {
-                    lx = x0, ly = y0, lz = z0, hx = x1, hy = y1, hz = z1;
+                    lx = box.lo.x, ly = box.lo.y, lz = box.lo.z, hx = box.hi.x, hy = box.hi.y, hz = box.hi.z;
                 } else {
-                    lx = std::min(lx, x0), ly = std::min(ly, y0), lz = std::min(lz, z0);
-                    hx = std::max(hx, x1), hy = std::max(hy, y1), hz = std::max(hz, z1);
+                    lx = std::min(lx, box.lo.x), ly = std::min(ly, box.lo.y), lz = std::min(lz, box.lo.z);
+                    hx = std::max(hx, box.hi.x), hy = std::max(hy, box.hi.y), hz = std::max(hz, box.hi.z);
                 }
             }
             Item& it = og.items[item];

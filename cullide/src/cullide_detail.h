@@ -24,6 +24,19 @@ namespace cullide::detail {
     return {{std::min(a.lo.x, b.lo.x), std::min(a.lo.y, b.lo.y), std::min(a.lo.z, b.lo.z)},
             {std::max(a.hi.x, b.hi.x), std::max(a.hi.y, b.hi.y), std::max(a.hi.z, b.hi.z)}};
 }
+// triangle_bounds written into `box` field by field: inline for the loops that box every triangle
+// of a frame, where an Aabb returned by value and copied into a list was packed through the stack
+// and read back before its stores had landed (store-forwarding stalls). std::min / std::max of two
+// keep the first of equal values, as of a list: triangle_bounds' bits, signed zeros included.
+inline void triangle_box(const Mesh& mesh, std::size_t triangle, Aabb& box) {
+    const Tri& t = mesh.triangles[triangle];
+    const Vec3& a = mesh.positions[t[0]];
+    const Vec3& b = mesh.positions[t[1]];
+    const Vec3& c = mesh.positions[t[2]];
+    box.lo.x = std::min(std::min(a.x, b.x), c.x), box.hi.x = std::max(std::max(a.x, b.x), c.x);
+    box.lo.y = std::min(std::min(a.y, b.y), c.y), box.hi.y = std::max(std::max(a.y, b.y), c.y);
+    box.lo.z = std::min(std::min(a.z, b.z), c.z), box.hi.z = std::max(std::max(a.z, b.z), c.z);
+}
 // Grows [lo, hi] by a margin that keeps geometry on its faces inside the clip volume after the
 // clip coordinates are rounded to float.
 void widen(double& lo, double& hi);

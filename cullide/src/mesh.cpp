@@ -9,15 +9,8 @@
 namespace cullide {
 
 Aabb triangle_bounds(const Mesh& mesh, std::size_t triangle) {
-    const Tri& t = mesh.triangles[triangle];
-    const Vec3& a = mesh.positions[t[0]];
-    const Vec3& b = mesh.positions[t[1]];
-    const Vec3& c = mesh.positions[t[2]];
     Aabb box;
-    for (int k = 0; k < 3; ++k) {
-        box.lo[k] = std::min({a[k], b[k], c[k]});
-        box.hi[k] = std::max({a[k], b[k], c[k]});
-    }
+    detail::triangle_box(mesh, triangle, box);
     return box;
 }
 
