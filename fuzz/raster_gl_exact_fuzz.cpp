@@ -20,6 +20,9 @@
 //   execute(threads = 2, allow_simd = false)               the tiled path, portable kernel
 //   execute(threads = 2, queries_only, clear_depth = the clear value): draws no query observes are
 //                                                          skipped (its query results only)
+//   execute(threads = 2, clear_depth = the clear value) twice on one target: the second clear
+//                                                          restores only the blocks the first run
+//                                                          wrote (the target's fast clear)
 // Property: each accepts exactly when the reference accepts (with the same message); when accepted,
 // the query results and (but for queries_only) every stored depth value are equal; when refused,
 // the target is unchanged.
@@ -237,6 +240,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         }
         if (got.value() != want.value()) fail("query results differ", p.name);
         if (!p.options.queries_only && !same(t.values(), reference.values())) fail("depth values differ", p.name);
+    }
+    if (want.ok()) {
+        // The fast clear (raster/depth_target.h): after a first run with clear_depth, the second
+        // one's clear fills only the blocks the first wrote, and must leave the reference's buffer.
+        raster::ExecuteOptions twice{2, true};
+        twice.clear_depth = clear;
+        raster::DepthTarget t = make_target(w, h, format, clear);
+        for (int run = 0; run < 2; ++run) {
+            const auto got = raster::execute(t, batch, twice);
+            if (!got.ok()) fail("refused a batch the reference ran", "fast clear, same target twice");
+            if (got.value() != want.value()) fail("query results differ", "fast clear, same target twice");
+            if (!same(t.values(), reference.values())) fail("depth values differ", "fast clear, same target twice");
+        }
     }
     return 0;
 }

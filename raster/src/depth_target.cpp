@@ -1,9 +1,13 @@
 // depth_target.cpp: DepthTarget storage, clear and read-back.
 #include "raster/depth_target.h"
 
+#include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <string>
+
+#include "target_blocks.h"
 
 namespace raster {
 
@@ -11,7 +15,8 @@ DepthTarget::DepthTarget(int width, int height, DepthFormat format)
     : width_(width),
       height_(height),
       format_(format),
-      values_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), encode_clear(1.0, format)) {}
+      values_(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), encode_clear(1.0, format)),
+      clear_value_(encode_clear(1.0, format)) {}
 
 Result<DepthTarget> DepthTarget::create(int width, int height, DepthFormat format) {
     if (width < 1 || height < 1 || width > kMaxTargetSize || height > kMaxTargetSize) {
@@ -41,7 +46,27 @@ std::uint32_t DepthTarget::encode_clear(double depth, DepthFormat format) {
 Status DepthTarget::clear(double depth) {
     if (!std::isfinite(depth)) return Error{"clear depth is not finite"};
     const std::uint32_t v = encode_clear(depth, format_);
-    for (auto& x : values_) x = v;
+    if (clear_known_ && clear_value_ == v) {
+        // Only the blocks that may differ (the fast clear: raster/depth_target.h).
+        std::array<std::uint32_t, kExecuteTileSize> row;
+        row.fill(v);
+        const int tiles_x = (width_ + kExecuteTileSize - 1) / kExecuteTileSize;
+        for (std::size_t i = 0; i < blocks_.size(); ++i) {
+            if (blocks_[i] == 0) continue;
+            const int x0 = static_cast<int>(i % static_cast<std::size_t>(tiles_x)) * kExecuteTileSize;
+            const int y0 = static_cast<int>(i / static_cast<std::size_t>(tiles_x)) * kExecuteTileSize;
+            detail::clear_blocks({values_.data(), width_}, row.data(),
+                                 {x0, y0, std::min(x0 + kExecuteTileSize, width_) - 1,
+                                  std::min(y0 + kExecuteTileSize, height_) - 1},
+                                 blocks_[i]);
+            blocks_[i] = 0;
+        }
+        return {};
+    }
+    std::fill(values_.begin(), values_.end(), v);
+    std::fill(blocks_.begin(), blocks_.end(), std::uint64_t{0});
+    clear_value_ = v;
+    clear_known_ = true;
     return {};
 }
 

@@ -1,12 +1,12 @@
 // execute.cpp: the scalar reference executor and the tiled (optionally multithreaded) executor.
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cmath>
-#include <cstring>
-#include <atomic>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -16,9 +16,10 @@
 #include <vector>
 
 #include "exact_bounds.h"
-#include "raster/detail/parallel.h"
 #include "pipeline.h"
 #include "raster/command_batch.h"
+#include "raster/detail/parallel.h"
+#include "target_blocks.h"
 #include "validate.h"
 
 #if defined(__SSE2__)
@@ -944,33 +945,6 @@ struct ShadeContext {
     const std::uint32_t* clear_row;
 };
 
-// Fills the blocks of `tile` flagged in `mask` (ExecuteOptions::written_blocks' layout) with copies
-// of `clear_row` (kTileSize values). Each row part by memcpy (wide stores on any target; the element
-// loop of std::fill stored one value per instruction): each block row's runs of flagged blocks (a
-// whole row of the tile when every block is flagged). A target of 4096^2 holds 64 MB and
-// raster_bench SmallTris writes one block in 13 there: restoring only those is most of the
-// difference (docs/raster.md, session 16).
-void clear_blocks(detail::DepthRows depth, const std::uint32_t* clear_row, detail::PixelRect tile, std::uint64_t mask) {
-    constexpr int B = kExecuteBlockSize;
-    static_assert(kTileSize == 8 * B, "one bit per block of a tile in a 64-bit mask");
-    for (int by = 0; mask != 0; ++by, mask >>= 8) {
-        unsigned bits = static_cast<unsigned>(mask & 0xffu);
-        const int ya = tile.y0 + by * B;
-        if (bits == 0 || ya > tile.y1) continue;
-        const int yb = std::min(ya + B - 1, tile.y1);
-        while (bits != 0) {  // each run of flagged blocks [b0, b1)
-            const int b0 = std::countr_zero(bits);
-            const int b1 = b0 + std::countr_one(bits >> b0);
-            bits &= ~((1u << b1) - (1u << b0));
-            const int xa = tile.x0 + b0 * B;
-            if (xa > tile.x1) break;
-            const int xb = std::min(tile.x0 + b1 * B - 1, tile.x1);
-            for (int y = ya; y <= yb; ++y)
-                std::memcpy(depth.row(y) + xa, clear_row, static_cast<std::size_t>(xb - xa + 1) * sizeof(std::uint32_t));
-        }
-    }
-}
-
 // How many bin references ahead shade prefetches a GL-exact triangle's set-up record.
 constexpr std::size_t kPrefetchAhead = 4;
 
@@ -1008,7 +982,8 @@ void shade(const ShadeContext& ctx, int tx, int ty, const std::vector<Ref>& bin,
     for (std::size_t j = 0; j < kPrefetchAhead && j < bin.size(); ++j) prefetch(bin[j]);
     std::uint64_t* const written = ctx.written_blocks != nullptr ? &ctx.written_blocks[tile_index] : nullptr;
     if (ctx.clear_row != nullptr) {
-        clear_blocks(ctx.depth, ctx.clear_row, {x0, y0, x1, y1}, written != nullptr ? *written : ~std::uint64_t{0});
+        detail::clear_blocks(ctx.depth, ctx.clear_row, {x0, y0, x1, y1},
+                             written != nullptr ? *written : ~std::uint64_t{0});
         if (written != nullptr) *written = 0;
     }
     if (hiz != nullptr) {
@@ -1142,17 +1117,33 @@ Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::spa
         const std::size_t n_queries = batch.query_kinds().size();
         if (scratch.answered.size() < n_queries + 1) scratch.answered = std::vector<std::atomic<bool>>(n_queries + 1);
         for (std::size_t q = 0; q <= n_queries; ++q) scratch.answered[q].store(false, std::memory_order_relaxed);
-        // Resized: new entries 0 (nothing written), or every block when this call clears (content
-        // unknown).
-        if (options.written_blocks != nullptr && options.written_blocks->size() != tiles.count())
-            options.written_blocks->assign(tiles.count(), options.clear_depth ? ~std::uint64_t{0} : 0);
+        // The blocks to fill before drawing and to flag where draws write: the caller's (resized:
+        // new entries 0, nothing written, or every block when this call clears, content unknown),
+        // or else the target's own record (DepthTarget's fast clear), which the caller's list
+        // replaces.
+        std::uint64_t* flags = nullptr;
+        if (options.written_blocks != nullptr) {
+            if (options.written_blocks->size() != tiles.count())
+                options.written_blocks->assign(tiles.count(), options.clear_depth ? ~std::uint64_t{0} : 0);
+            flags = options.written_blocks->data();
+            detail::TargetBlocks::forget(target);
+        } else {
+            flags = detail::TargetBlocks::begin_batch(target, options.clear_depth.has_value(), clear_row[0]);
+        }
         draw_infos(batch, draw_list, d0, d1, setup, target.format(), options.allow_simd, hiz, scratch.infos);
-        const ShadeContext ctx{draw_list,      setup,           scratch.infos.data(),
-                               {target.mutable_values().data(), target.width()},
-                               target.width(), target.height(), target.format(),
-                               options.allow_simd, hiz, scratch.hiz_tiles.data(),
-                               options.written_blocks != nullptr ? options.written_blocks->data() : nullptr,
-                               scratch.answered.data(), options.clear_depth ? clear_row.data() : nullptr};
+        const ShadeContext ctx{draw_list,
+                               setup,
+                               scratch.infos.data(),
+                               {detail::TargetBlocks::values(target), target.width()},
+                               target.width(),
+                               target.height(),
+                               target.format(),
+                               options.allow_simd,
+                               hiz,
+                               scratch.hiz_tiles.data(),
+                               flags,
+                               scratch.answered.data(),
+                               options.clear_depth ? clear_row.data() : nullptr};
         auto& tile_counts = scratch.tile_counts;
         reset_lists(tile_counts, tiles.count());
         detail::parallel_for(threads, tiles.count(), [&](std::size_t tile) {
@@ -1165,6 +1156,7 @@ Result<std::vector<QueryResults>> execute_sequence(DepthTarget& target, std::spa
             }
             shade(ctx, tx, ty, list, tile_counts[tile]);
         });
+        if (options.written_blocks == nullptr && flags != nullptr) detail::TargetBlocks::commit(target);
 
         QueryResults results(n_queries, 0);
         for (std::size_t tile = 0; tile < tiles.count(); ++tile)

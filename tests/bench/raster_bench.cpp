@@ -11,9 +11,14 @@
 //   LargeTris/<size>/<threads>: 200 triangles covering ~1/8 of the target each, LESS, writes on.
 //   CullideAny/<size>/<threads>: Cullide with any-samples queries (what cullide.cpp issues): the
 //     executor stops a query at its first passing sample.
-//   SmallTrisRestore, LargeTrisRestore: the emulator on SmallTris and LargeTris, each run's clear
-//     restoring only the 8 x 8 blocks the previous run wrote (ExecuteOptions::written_blocks, as
-//     CULLIDE's emulator device clears); checked after timing: the buffer equals a full clear's.
+//   Each run of ours starts with ExecuteOptions::clear_depth = 1 (OSMesa's with glClear). On
+//   SmallTris, LargeTris, Cullide and CullideAny that clear is the target's fast clear (only the
+//   8 x 8 blocks the previous run wrote are filled: DepthTarget's record).
+//   SmallTrisRestore, LargeTrisRestore: the same with the caller's list of those blocks
+//     (ExecuteOptions::written_blocks, as CULLIDE's emulator device clears).
+//   SmallTrisFullClear: every run fills the whole buffer, as llvmpipe does (the record is dropped
+//     before each run).
+//   Checked after timing for every clear of ours: the buffer equals a full clear's.
 // threads = 0 means the OSMesa oracle (llvmpipe with its default thread count). A third argument
 // simd: 1 = default kernel choice (AVX2 8-wide when the CPU has it), 0 = the portable kernel.
 //   Reliable/<size>/<mode>: the Cullide workload's 2000 boxes (world = clip: a [-1, 1]^3 view along
@@ -125,11 +130,14 @@ std::uint64_t digest(const raster::QueryResults& r) {
     return h;
 }
 
-// restore_written: the timed runs keep ExecuteOptions::written_blocks from one run to the next, so
-// that each run's clear restores only the 8 x 8 blocks the previous run wrote (how CULLIDE's
-// emulator device clears between passes); the buffer and results are those of a full clear. Off:
-// every run fills the whole buffer, as llvmpipe does.
-void run(benchmark::State& state, Kind kind, bool restore_written) {
+// How each timed run of ours clears (the buffer and results are those of a full clear every time):
+// Fast: the target's own record of the blocks written since its last clear (DepthTarget's fast
+// clear); Written: the caller's ExecuteOptions::written_blocks kept from one run to the next (how
+// CULLIDE's emulator device clears between passes); Full: every pixel, as llvmpipe does.
+enum class Clear { Fast, Written, Full };
+
+void run(benchmark::State& state, Kind kind, Clear clear) {
+    const bool restore_written = clear == Clear::Written;
     const int size = static_cast<int>(state.range(0));
     const int threads = static_cast<int>(state.range(1));
     const bool simd = state.range(2) != 0;
@@ -182,22 +190,25 @@ void run(benchmark::State& state, Kind kind, bool restore_written) {
         std::vector<std::uint64_t> written;  // empty: the first run fills every block
         if (restore_written) options.written_blocks = &written;
         for (auto _ : state) {
+            if (clear == Clear::Full) (void)target.value().mutable_values();  // forgets the record
             auto r = raster::execute(target.value(), w->batch, options);
             benchmark::DoNotOptimize(r);
         }
-        if (restore_written) {  // the restored buffer is the fully cleared one
+        {  // the buffer after the last run is the one a fully cleared target gives
             auto full = raster::DepthTarget::create(size, size, raster::DepthFormat::D24);
             auto r = raster::execute(full.value(), w->batch, raster::ExecuteOptions{threads, simd});
             const auto a = target.value().values(), b = full.value().values();
             if (!r.ok() || digest(r.value()) != want || !std::equal(a.begin(), a.end(), b.begin(), b.end()))
-                state.SkipWithError("restoring the written blocks gave another buffer than a full clear");
+                state.SkipWithError("the clear of the timed runs gave another buffer than a full clear");
         }
     }
     state.counters["tris/s"] = benchmark::Counter(static_cast<double>(w->triangles), benchmark::Counter::kIsIterationInvariantRate);
     state.counters["queries/s"] = benchmark::Counter(static_cast<double>(w->queries), benchmark::Counter::kIsIterationInvariantRate);
     state.SetLabel(threads == 0 ? "osmesa-llvmpipe"
                                 : std::string(simd ? "cullide-raster" : "cullide-raster-portable") +
-                                      (restore_written ? "+written-blocks" : ""));
+                                      (restore_written        ? "+written-blocks"
+                                       : clear == Clear::Full ? "+full-clear"
+                                                              : ""));
 }
 
 void args(benchmark::internal::Benchmark* b) {
@@ -296,12 +307,13 @@ void run_reliable(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(run_reliable)->ArgsProduct({{256, 1024}, {0, 1, 2, 3}})->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(run, Cullide, Kind::Cullide, false)->Apply(args);
-BENCHMARK_CAPTURE(run, SmallTris, Kind::SmallTris, false)->Apply(args);
-BENCHMARK_CAPTURE(run, LargeTris, Kind::LargeTris, false)->Apply(args);
-BENCHMARK_CAPTURE(run, SmallTrisRestore, Kind::SmallTris, true)->Apply(args_emulator);
-BENCHMARK_CAPTURE(run, LargeTrisRestore, Kind::LargeTris, true)->Apply(args_emulator);
-BENCHMARK_CAPTURE(run, CullideAny, Kind::CullideAny, false)->Apply(args);
+BENCHMARK_CAPTURE(run, Cullide, Kind::Cullide, Clear::Fast)->Apply(args);
+BENCHMARK_CAPTURE(run, SmallTris, Kind::SmallTris, Clear::Fast)->Apply(args);
+BENCHMARK_CAPTURE(run, LargeTris, Kind::LargeTris, Clear::Fast)->Apply(args);
+BENCHMARK_CAPTURE(run, SmallTrisRestore, Kind::SmallTris, Clear::Written)->Apply(args_emulator);
+BENCHMARK_CAPTURE(run, LargeTrisRestore, Kind::LargeTris, Clear::Written)->Apply(args_emulator);
+BENCHMARK_CAPTURE(run, SmallTrisFullClear, Kind::SmallTris, Clear::Full)->Apply(args_emulator);
+BENCHMARK_CAPTURE(run, CullideAny, Kind::CullideAny, Clear::Fast)->Apply(args);
 
 namespace {
 

@@ -349,3 +349,174 @@ TEST_CASE("A non-finite clear_depth is an error naming it, and changes nothing")
         CHECK(std::vector<std::uint32_t>(t.value().values().begin(), t.value().values().end()) == before);
     }
 }
+
+// DepthTarget's fast clear (raster/depth_target.h): a clear, or an execute() with clear_depth,
+// fills only the blocks that may differ from the value the target was last cleared to. Random
+// sequences of every operation that touches a target (clears to the same and to other values,
+// executes with and without clear_depth, sequences whose between() writes pixels, writes through
+// mutable_values(), queries_only runs, the caller's own written_blocks) must give the counts and
+// the buffer of a target that is filled in full at every clear and drawn by execute_reference.
+TEST_CASE(
+    "The fast clear: any sequence of clears, executes and writes gives the counts and buffer of full "
+    "clears") {
+    struct Size {
+        int w, h;
+    };
+    const Size sizes[] = {{64, 64}, {200, 130}, {333, 77}, {70, 260}};
+    const raster::DepthFormat formats[] = {raster::DepthFormat::D16, raster::DepthFormat::D24,
+                                           raster::DepthFormat::D32F};
+    const double clears[] = {1.0, 1.0, 1.0, 0.75, 0.0, 0.5};
+    int compared = 0, value_changes = 0, writes = 0;
+    for (std::size_t si = 0; si < std::size(sizes); ++si) {
+        const Size sz = sizes[si];
+        const raster::DepthFormat format = formats[si % 3];
+        raster_test::SplitMix64 scene_rng(0xfa57c1ea + si);
+        raster_test::SceneOptions so;
+        so.width = sz.w;
+        so.height = sz.h;
+        so.objects = 30;
+        raster_test::Scene pool[4];
+        for (auto& sc : pool) raster_test::build_scene(sc, scene_rng, so);
+        for (const raster_test::ThreadRun run : raster_test::kThreadRuns) {
+            if (run.threads == 8) continue;
+            const raster::detail::SpreadScheduleScope schedule(run.spread);
+            CAPTURE(sz.w);
+            CAPTURE(sz.h);
+            CAPTURE(run.threads);
+            CAPTURE(run.spread);
+            raster_test::SplitMix64 rng(0x5eed + si);  // the same operations for every thread run
+            auto made = raster::DepthTarget::create(sz.w, sz.h, format);
+            auto made_ref = raster::DepthTarget::create(sz.w, sz.h, format);
+            REQUIRE(made.ok());
+            REQUIRE(made_ref.ok());
+            raster::DepthTarget& t = made.value();
+            raster::DepthTarget& ref = made_ref.value();  // filled by hand, drawn by execute_reference
+            const auto fill_ref = [&](double depth) {
+                const std::uint32_t v = raster::DepthTarget::encode_clear(depth, format);
+                for (auto& x : ref.mutable_values()) x = v;
+            };
+            // A few pixels written behind the executor's back (valid values of the format).
+            const auto write_pixels = [&](raster::DepthTarget& target, std::uint64_t seed) {
+                raster_test::SplitMix64 w(seed);
+                const std::span<std::uint32_t> a = target.mutable_values();
+                for (int k = 0; k < 12; ++k) {
+                    const std::size_t i = w.next() % a.size();
+                    a[i] = static_cast<std::uint32_t>(w.next()) &
+                           (format == raster::DepthFormat::D16 ? 0xffffu : 0x3f7fffffu);
+                }
+                ++writes;
+            };
+            bool defined = true;  // false after a queries_only run: the content is unspecified
+            double last = 1.0;
+            for (int step = 0; step < 30; ++step) {
+                CAPTURE(step);
+                int op = static_cast<int>(rng.below(7));
+                if (!defined && op != 0 && op != 1 && op != 6) op = 1;  // only a clear makes it defined
+                const double c = clears[rng.below(static_cast<std::uint32_t>(std::size(clears)))];
+                value_changes += c != last && (op == 0 || op == 1 || op == 3 || op == 5 || op == 6) ? 1 : 0;
+                const raster_test::Scene& sc = pool[rng.below(4)];
+                CAPTURE(op);
+                CAPTURE(c);
+                raster::ExecuteOptions eo{run.threads};
+                if (op == 0) {  // DepthTarget::clear
+                    REQUIRE(t.clear(c).ok());
+                    fill_ref(c);
+                    last = c;
+                    defined = true;
+                } else if (op == 1 || op == 2 || op == 6) {  // execute: clearing (6: own list) or not
+                    std::vector<std::uint64_t> own;  // empty: every block flagged
+                    if (op != 2) eo.clear_depth = c;
+                    if (op == 6) eo.written_blocks = &own;
+                    auto r = raster::execute(t, sc.batch, eo);
+                    if (op != 2) fill_ref(c), last = c;
+                    auto want = raster::execute_reference(ref, sc.batch);
+                    REQUIRE(r.ok());
+                    REQUIRE(want.ok());
+                    CHECK(r.value() == want.value());
+                    defined = defined || op != 2;
+                } else if (op == 3) {  // a sequence, clearing each batch or not, between() writing pixels
+                    const bool clearing = rng.chance(70);
+                    if (clearing) eo.clear_depth = c;
+                    const std::uint64_t seed = rng.next();
+                    const raster::CommandBatch* seq[3] = {
+                        &pool[rng.below(4)].batch, &pool[rng.below(4)].batch, &pool[rng.below(4)].batch};
+                    // between(k) also clears (to the value of bits 8-10 of the seed) when bit k + 4 is set.
+                    const double between_clear = clears[(seed >> 8) % std::size(clears)];
+                    auto r = raster::execute_sequence(t, seq, eo, [&](std::size_t k) {
+                        if ((seed >> (k + 4)) & 1u) REQUIRE(t.clear(between_clear).ok());
+                        if ((seed >> k) & 1u) write_pixels(t, seed + k);
+                    });
+                    REQUIRE(r.ok());
+                    for (std::size_t k = 0; k < 3; ++k) {
+                        if (k > 0 && ((seed >> (k + 4)) & 1u)) fill_ref(between_clear);
+                        if (k > 0 && ((seed >> k) & 1u))
+                            write_pixels(ref, seed + k);  // the same, at the same moment
+                        if (clearing) fill_ref(c);
+                        auto want = raster::execute_reference(ref, *seq[k]);
+                        REQUIRE(want.ok());
+                        CHECK(r.value()[k] == want.value());
+                    }
+                    if (clearing) last = c;
+                } else if (op == 4) {  // writes through mutable_values()
+                    const std::uint64_t seed = rng.next();
+                    write_pixels(t, seed);
+                    write_pixels(ref, seed);
+                } else {  // op 5: queries_only (CULLIDE's recorded passes): counts only, content unspecified
+                    eo.clear_depth = c;
+                    eo.queries_only = true;
+                    auto r = raster::execute(t, sc.batch, eo);
+                    fill_ref(c);
+                    last = c;
+                    auto want = raster::execute_reference(ref, sc.batch);
+                    REQUIRE(r.ok());
+                    REQUIRE(want.ok());
+                    CHECK(r.value() == want.value());
+                    defined = false;
+                }
+                if (defined) {
+                    CHECK(std::equal(t.values().begin(), t.values().end(), ref.values().begin(),
+                                     ref.values().end()));
+                    ++compared;
+                }
+            }
+        }
+    }
+    CHECK(compared > 400);
+    CHECK(value_changes > 40);
+    CHECK(writes > 40);
+}
+
+// The fast clear skips the blocks it knows hold the clear value: a pixel changed through a span
+// kept past the next execute() (which the span's contract does not allow) is left as it is by a
+// clear to the same value, and filled by a clear to another value or after mutable_values().
+TEST_CASE("The fast clear fills only blocks a draw wrote since the last clear to the same value") {
+    auto made = raster::DepthTarget::create(128, 128, raster::DepthFormat::D24);
+    REQUIRE(made.ok());
+    raster::DepthTarget& t = made.value();
+    // One triangle in the bottom-left tile, written at depth 0.
+    raster::CommandBatch batch(128, 128);
+    const std::vector<raster::Float4> v = {
+        {-1.0f, -1.0f, -1.0f, 1.0f}, {-0.8f, -1.0f, -1.0f, 1.0f}, {-1.0f, -0.8f, -1.0f, 1.0f}};
+    const std::vector<std::uint32_t> idx = {0, 1, 2};
+    raster::DrawState write;
+    write.depth_func = raster::DepthFunc::Always;
+    batch.draw({v, idx}, write);
+    const std::span<std::uint32_t> stale = t.mutable_values();  // forgets: the next clear fills all
+    raster::ExecuteOptions eo;
+    eo.clear_depth = 1.0;
+    REQUIRE(raster::execute(t, batch, eo).ok());
+    const std::uint32_t one = raster::DepthTarget::encode_clear(1.0, raster::DepthFormat::D24);
+    CHECK(t.value(1, 1) == 0u);  // drawn
+    CHECK(t.value(100, 100) == one);
+    stale[100 * 128 + 100] = 7;  // behind the target's back, in a block no draw wrote
+    REQUIRE(t.clear(1.0).ok());
+    CHECK(t.value(1, 1) == one);     // the written block is filled ...
+    CHECK(t.value(100, 100) == 7u);  // ... the other one is known to hold 1 and left alone
+    REQUIRE(raster::execute(t, batch, eo).ok());
+    CHECK(t.value(100, 100) == 7u);  // (execute's own clear the same)
+    REQUIRE(t.clear(0.5).ok());      // another value: every pixel
+    CHECK(t.value(100, 100) == raster::DepthTarget::encode_clear(0.5, raster::DepthFormat::D24));
+    t.mutable_values()[100 * 128 + 100] = 9;  // through mutable_values(): forgotten, filled again
+    REQUIRE(t.clear(0.5).ok());
+    CHECK(t.value(100, 100) == raster::DepthTarget::encode_clear(0.5, raster::DepthFormat::D24));
+}

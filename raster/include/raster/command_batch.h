@@ -88,7 +88,9 @@ struct ExecuteOptions {
     // DepthTarget::clear(*clear_depth) before each batch (execute_reference does exactly that).
     // The tiled executor fills each tile in the tile's own task, before its first draw there: in
     // parallel, and while the tile is in that core's cache (a separate DepthTarget::clear is one
-    // serial pass over the whole buffer). With written_blocks, only the blocks flagged there are
+    // serial pass over the whole buffer). Without written_blocks, the target's own record decides
+    // (DepthTarget's fast clear): after a clear to the same depth, only the blocks its draws wrote
+    // since are filled. With written_blocks, only the blocks flagged there are
     // filled, and their bits reset before the batch's draws set them again: the caller's promise
     // that the other blocks hold this depth already, which execute() keeps from one call to the
     // next when every call uses the same clear_depth. If written_blocks has to be resized, every
