@@ -19,10 +19,7 @@ Result<bool> EmulatorDevice::ensure_target(int width, int height, raster::DepthF
         return false;
     raster::Result<raster::DepthTarget> t = raster::DepthTarget::create(width, height, format);
     if (!t) return Error{"emulator device: " + t.error().message};
-    target_.emplace(std::move(t).value());
-    // A new target is created cleared to 1.0: nothing written yet.
-    constexpr int side = raster::kExecuteTileSize;
-    written_blocks_.assign(static_cast<std::size_t>((width + side - 1) / side) * static_cast<std::size_t>((height + side - 1) / side), 0);
+    target_.emplace(std::move(t).value());  // cleared to 1.0
     return true;
 }
 
@@ -30,9 +27,10 @@ Status EmulatorDevice::clear(int width, int height, raster::DepthFormat format) 
     Result<bool> created = ensure_target(width, height, format);
     if (!created) return created.error();
     if (created.value()) return Status{};
-    // Only the 8 x 8 blocks where a writing draw of raster::execute passed the depth test
-    // (ExecuteOptions::written_blocks) can differ from depth 1.0: an empty batch with clear_depth
-    // restores exactly those, each tile's in its own task, which gives the same buffer as a full clear.
+    // Only the 8 x 8 blocks where a writing draw of raster::execute passed the depth test can
+    // differ from depth 1.0 (the target's record, DepthTarget's fast clear): an empty batch with
+    // clear_depth restores exactly those, each tile's in its own task, which gives the same buffer
+    // as a full clear.
     raster::ExecuteOptions options = execute_options();
     options.clear_depth = 1.0;
     raster::Result<raster::QueryResults> r = raster::execute(*target_, raster::CommandBatch(width, height), options);
@@ -40,10 +38,9 @@ Status EmulatorDevice::clear(int width, int height, raster::DepthFormat format) 
     return Status{};
 }
 
-raster::ExecuteOptions EmulatorDevice::execute_options() {
+raster::ExecuteOptions EmulatorDevice::execute_options() const {
     raster::ExecuteOptions eo;
     eo.threads = threads_;
-    eo.written_blocks = &written_blocks_;  // the blocks the next clear restores
     return eo;
 }
 

@@ -42,19 +42,15 @@ class EmulatorDevice final : public QueryDevice {
     [[nodiscard]] const raster::DepthTarget* target() const { return target_ ? &*target_ : nullptr; }
 
    private:
-    // The executor's options for this device: its thread count, and the written blocks the next
-    // clear restores.
-    raster::ExecuteOptions execute_options();
+    // The executor's options for this device: its thread count. (The blocks a clear restores are
+    // the target's own record: DepthTarget's fast clear.)
+    [[nodiscard]] raster::ExecuteOptions execute_options() const;
     // Makes target_ a width x height target of `format`: true when it was created (cleared to 1.0,
     // no tile written), false when the current one already fits (its content kept).
     Result<bool> ensure_target(int width, int height, raster::DepthFormat format);
 
     int threads_;
     std::optional<raster::DepthTarget> target_;
-    // Per 64 x 64 tile of the target (raster::kExecuteTileSize, row-major), a mask of its 8 x 8
-    // blocks where a draw with the depth mask on passed the depth test since the last clear (filled
-    // in by raster::execute, ExecuteOptions::written_blocks; a clear resets what it restores).
-    std::vector<std::uint64_t> written_blocks_;
 };
 
 }  // namespace cullide::detail
