@@ -424,7 +424,7 @@ TEST_CASE(
                     last = c;
                     defined = true;
                 } else if (op == 1 || op == 2 || op == 6) {  // execute: clearing (6: own list) or not
-                    std::vector<std::uint64_t> own;  // empty: every block flagged
+                    std::vector<std::uint64_t> own;          // empty: every block flagged
                     if (op != 2) eo.clear_depth = c;
                     if (op == 6) eo.written_blocks = &own;
                     auto r = raster::execute(t, sc.batch, eo);
