@@ -13,7 +13,8 @@
 #         passes that split one target between threads (the fused pass's runs, Quick-CULLIDE's
 #         windowed passes), against their recorded forms; and the spread-schedule cases, where
 #         threads of their own must run items (raster/detail/parallel.h, spatialhash's executor),
-#         every pipeline method too
+#         every pipeline method too; and the fast clear's random sequences (a target's record
+#         across calls at 1-3 threads)
 #   full  every library and unit test, all unit tests
 #   CULLIDE_TSAN_BUILD  build folder (default build-tsan)
 set -euo pipefail
@@ -75,7 +76,7 @@ if [ "$mode" = short ]; then
   cmake --build "$build" -j"$(nproc)" --target raster_threads_test spatialhash_api_test ground_truth_test \
     golden_digest_test raster_visibility_test quick_cullide_test fused_visibility_test raster_parallel_test spatialhash_stages_test \
     raster_simd_test cullide_pipeline_test
-  select=(-R 'for 1, 2, 3 and 8 threads|are identical for 1, 2, 3 and 8|same for 1, 2, 3 and 8|Repeated runs|golden digests:|split between threads|WindowedPasses .each|native windowed passes|Fused and recorded R-CULLIDE|spread schedule')
+  select=(-R 'for 1, 2, 3 and 8 threads|are identical for 1, 2, 3 and 8|same for 1, 2, 3 and 8|Repeated runs|golden digests:|split between threads|WindowedPasses .each|native windowed passes|Fused and recorded R-CULLIDE|spread schedule|The fast clear: any sequence')
 else
   cmake --build "$build" -j"$(nproc)"
   select=(-L unit -LE slow)
