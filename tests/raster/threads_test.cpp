@@ -1,11 +1,13 @@
 // threads_test.cpp: the tiled executor equals the scalar reference bit for bit, for 1, 2, 3 and 8
-// threads, on random scenes (no OSMesa needed: the reference is the independent twin).
+// threads, on random scenes (no OSMesa needed: the reference is the independent twin); its clears
+// (clear_depth, written_blocks, the target's fast clear) equal full clears.
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <cstdint>
 #include <iterator>
 #include <limits>
+#include <span>
 #include <string>
 #include <vector>
 
