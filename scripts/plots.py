@@ -4,6 +4,8 @@
 usage:
   scripts/plots.py figures DATA_DIR IMG_DIR     every figure whose CSV is in DATA_DIR
   scripts/plots.py tables DATA_DIR              the markdown tables of docs/results.md, on stdout
+  scripts/plots.py goals GOALS_DIR              the goal tables of issues #16 and #17 from the files
+                                                of `scripts/results.sh --goals`, on stdout
   scripts/plots.py bunnies-input MESH_DIR OUT   writes OUT/bunny_a.obj, OUT/bunny_b.obj: two
                                                 interpenetrating bunnies (a stand-in blob when
                                                 MESH_DIR has no stanford-bunny.obj)
@@ -438,6 +440,178 @@ def tables(data_dir):
     print("\n".join(out))
 
 
+# ---- goal tables of the speed issues (scripts/results.sh --goals) --------------------------------
+
+def load_lines(goals_dir):
+    p = os.path.join(goals_dir, "load.txt")
+    return open(p).read().strip().splitlines() if os.path.exists(p) else []
+
+
+def ratio_range(values):
+    return f"{min(values):.2f}-{max(values):.2f}x" if values else "-"
+
+
+def goals(goals_dir):
+    """Prints the goal tables of issues #16 and #17 from peers.csv, threads.csv, self.csv,
+    pipeline_bench.json and raster_bench.json (each written by one run of scripts/results.sh
+    --goals); 'yes' / 'no' says whether each row reaches its goal."""
+    import json
+    out = []
+    loads = load_lines(goals_dir)
+    if loads:
+        out.append("Runs (`scripts/results.sh --goals`; the load average before each run):\n")
+        out.extend(f"    {line}" for line in loads)
+        out.append("")
+    yes = lambda ok: "yes" if ok else "**no**"
+    # #16, peers side by side at 2 threads.
+    p = os.path.join(goals_dir, "peers.csv")
+    if os.path.exists(p):
+        rows = read_csv(p)
+        out.append("### Issue #16: never-miss methods against the best exact peer (`peers_bench`, 2 threads, ms per deforming frame)\n")
+        out.append("| scene | best exact peer ms | exact ms (/ peer, goal <= 1x) | auto ms (/ peer, goal <= 0.5x) | rcullide ms (/ exact, goal < 1x where boxes are loose) | qcullide ms |")
+        out.append("|---|---|---|---|---|---|")
+        summary = {"exact": [], "auto": [], "rcullide": []}
+        for scene, rs in by(rows, "scene").items():
+            peers = [r for r in rs if r["build_ms"] != "" and r["exact"] == "yes"]
+            mine = {r["peer"].split("@")[0]: r for r in rs if r["build_ms"] == ""}
+            if not peers or "exact" not in mine:
+                continue
+            best = min(peers, key=lambda r: fnum(r, "frame_ms"))
+            bms = fnum(best, "frame_ms")
+            ex = fnum(mine["exact"], "frame_ms")
+            cells = [f"{best['peer']} {fmt_ms(bms)}", f"{fmt_ms(ex)} ({ex / bms:.2f}x, {yes(ex <= bms and mine['exact']['exact'] == 'yes')})"]
+            summary["exact"].append(ex <= bms)
+            if "auto" in mine:
+                a = fnum(mine["auto"], "frame_ms")
+                ok = a <= 0.5 * bms and mine["auto"]["exact"] == "yes"
+                summary["auto"].append(ok)
+                cells.append(f"{fmt_ms(a)} ({a / bms:.2f}x, {yes(ok)})")
+            else:
+                cells.append("-")
+            if "rcullide" in mine:
+                rc = fnum(mine["rcullide"], "frame_ms")
+                loose = scene in ("tori", "bunny-dragon", "breaking", "cloth")
+                goal = ""
+                if loose:
+                    goal = f", {yes(rc < ex)}"
+                    summary["rcullide"].append(rc < ex)
+                if scene == "cylinders":
+                    goal = f"; goal <= 1 ms: {yes(rc <= 1.0)}"
+                cells.append(f"{fmt_ms(rc)} ({rc / ex:.2f}x{goal})")
+            else:
+                cells.append("-")
+            cells.append(fmt_ms(fnum(mine["qcullide"], "frame_ms")) if "qcullide" in mine else "-")
+            out.append(f"| {scene} | " + " | ".join(cells) + " |")
+        out.append("")
+        out.append("Reached on: " + ", ".join(f"{k} {sum(v)} of {len(v)} scenes" for k, v in summary.items() if v) + ".\n")
+    # #16, 1 -> 2 threads.
+    p = os.path.join(goals_dir, "threads.csv")
+    if os.path.exists(p):
+        rows = read_csv(p)
+        out.append("### Issue #16: 1 -> 2 threads (`cullide bench --threads 1,2`, ms per frame, medians; goal >= 1.8x)\n")
+        out.append("| scene | method | 1 thread | 2 threads | 2 / 1 | reached |")
+        out.append("|---|---|---|---|---|---|")
+        speedups = []
+        for (scene, method), rs in by_pair(rows, "scene", "method").items():
+            t = {r["threads"]: fnum(r, "ms_median") for r in rs}
+            if "1" not in t or "2" not in t:
+                continue
+            sp = t["1"] / max(1e-9, t["2"])
+            speedups.append(sp)
+            out.append(f"| {scene} | {method} | {fmt_ms(t['1'])} | {fmt_ms(t['2'])} | {sp:.2f}x | {yes(sp >= 1.8)} |")
+        out.append("")
+        out.append(f"2 / 1: {ratio_range(speedups)}; >= 1.8x on {sum(x >= 1.8 for x in speedups)} of {len(speedups)} rows.\n")
+    # #16, self-collision on the folded cloth.
+    p = os.path.join(goals_dir, "self.csv")
+    if os.path.exists(p):
+        rows = read_csv(p)
+        t = {(r["method"], r["threads"]): r for r in rows}
+        if all(k in t for k in (("exact", "1"), ("exact", "2"), ("qcullide", "1"), ("qcullide", "2"))):
+            ms = {k: fnum(v, "ms_median") for k, v in t.items()}
+            out.append("### Issue #16: self-collision on the folded cloth (`cullide bench --self`, frames 55-56, ms per frame)\n")
+            out.append("| threads | exact --self | qcullide --self | qcullide / exact (goal <= 0.5x) | exact tests, exact / qcullide |")
+            out.append("|---|---|---|---|---|")
+            for th in ("1", "2"):
+                r = ms[("qcullide", th)] / ms[("exact", th)]
+                out.append(f"| {th} | {fmt_ms(ms[('exact', th)])} | {fmt_ms(ms[('qcullide', th)])} | {r:.2f}x ({yes(r <= 0.5)}) | "
+                           f"{t[('exact', th)]['exact_tests']} / {t[('qcullide', th)]['exact_tests']} |")
+            sp = ms[("qcullide", "1")] / ms[("qcullide", "2")]
+            out.append("")
+            out.append(f"qcullide --self 1 -> 2 threads: {sp:.2f}x (goal >= 1.8x: {yes(sp >= 1.8)}).\n")
+    # #17, the GL-exact passes on the emulator against OSMesa.
+    p = os.path.join(goals_dir, "pipeline_bench.json")
+    if os.path.exists(p):
+        doc = json.load(open(p))
+        t = {}
+        for b in doc.get("benchmarks", []):
+            parts = b["name"].split("/")  # pipeline/<scene>@<scale>/<method>/<device>/threads:N/...
+            if len(parts) < 5 or b.get("run_type") != "iteration":
+                continue
+            t[(parts[1], parts[2], parts[3], parts[4])] = b["real_time"]
+        keys = []
+        for (scene, method, device, th) in t:
+            if device == "osmesa" and (scene, method) not in keys:
+                keys.append((scene, method))
+        out.append("### Issue #17: GL-exact passes, emulator against OSMesa llvmpipe (`pipeline_bench`, ms per frame)\n")
+        out.append(f"Load average in the benchmark's context: {doc.get('context', {}).get('load_avg', '?')}.\n")
+        out.append("| scene / method | emulator 1 / 2 threads | 2 / 1 (goal >= 1.8x) | OSMesa | OSMesa / emulator at 2 threads (goal >= 20x) |")
+        out.append("|---|---|---|---|---|")
+        fast, scale = [], []
+        for scene, method in keys:
+            e1 = t.get((scene, method, "emulator", "threads:1"))
+            e2 = t.get((scene, method, "emulator", "threads:2"))
+            om = t.get((scene, method, "osmesa", "threads:2"))
+            if e1 is None or e2 is None or om is None:
+                continue
+            sp, r = e1 / e2, om / e2
+            fast.append(r)
+            scale.append(sp)
+            out.append(f"| {scene.split('@')[0]} / {method} | {fmt_ms(e1)} / {fmt_ms(e2)} | {sp:.2f}x ({yes(sp >= 1.8)}) | "
+                       f"{fmt_ms(om)} | {r:.1f}x ({yes(r >= 20)}) |")
+        out.append("")
+        out.append(f"OSMesa / emulator {ratio_range(fast)}, 20x on {sum(x >= 20 for x in fast)} of {len(fast)} rows; "
+                   f"1 -> 2 threads {ratio_range(scale)}, 1.8x on {sum(x >= 1.8 for x in scale)} of {len(scale)} rows.\n")
+    # #17, fill rate against llvmpipe.
+    p = os.path.join(goals_dir, "raster_bench.json")
+    if os.path.exists(p):
+        doc = json.load(open(p))
+        t = {}
+        for b in doc.get("benchmarks", []):
+            parts = b["name"].split("/")  # run/<workload>/<size>/<threads>/<simd>/real_time
+            if parts[0] != "run" or len(parts) < 5 or b.get("run_type") != "iteration":
+                continue
+            t[(parts[1], int(parts[2]), int(parts[3]), int(parts[4]))] = b["real_time"]
+        out.append("### Issue #17: raster throughput against OSMesa llvmpipe (`raster_bench`, ms per batch)\n")
+        out.append(f"Load average in the benchmark's context: {doc.get('context', {}).get('load_avg', '?')}. "
+                   "Goals: LargeTris >= 2x, SmallTris >= 4x llvmpipe at 2 threads.\n")
+        out.append("| workload | size | OSMesa | ours 1 thread (portable) | ours 2 threads | OSMesa / ours at 1 / 2 threads | 2 / 1 | goal |")
+        out.append("|---|---|---|---|---|---|---|---|")
+        workloads = []
+        for (w, size, th, simd) in t:
+            if w not in workloads:
+                workloads.append(w)
+        for w in workloads:
+            for size in sorted({k[1] for k in t if k[0] == w}):
+                one, two = t.get((w, size, 1, 1)), t.get((w, size, 2, 1))
+                if one is None or two is None:
+                    continue
+                om = t.get((w, size, 0, 1))
+                port = t.get((w, size, 1, 0))
+                base = w if w not in ("SmallTrisRestore", "SmallTrisFullClear") else "SmallTris"
+                if w == "LargeTrisRestore":
+                    base = "LargeTris"
+                om = om if om is not None else t.get((base, size, 0, 1))
+                goal = {"LargeTris": 2.0, "SmallTris": 4.0}.get(w)
+                ratio = f"{om / one:.1f}x / {om / two:.1f}x" if om else "-"
+                reached = (f">= {goal:g}x: {yes(om / two >= goal)}" if goal and om else "-")
+                out.append(f"| {w} | {size}^2 | {fmt_ms(om) if om else '-'} | {fmt_ms(one)}" +
+                           (f" ({fmt_ms(port)})" if port else "") + f" | {fmt_ms(two)} | {ratio} | {one / two:.2f}x | {reached} |")
+        out.append("")
+        out.append("OSMesa runs once per workload and size (llvmpipe's own threads); the Restore and FullClear "
+                   "rows are compared with the OSMesa time of their workload.\n")
+    print("\n".join(out))
+
+
 def main(argv):
     if len(argv) >= 4 and argv[1] == "figures":
         figures(argv[2], argv[3])
@@ -445,6 +619,8 @@ def main(argv):
         bunnies_input(argv[2], argv[3])
     elif len(argv) >= 3 and argv[1] == "tables":
         tables(argv[2])
+    elif len(argv) >= 3 and argv[1] == "goals":
+        goals(argv[2])
     elif len(argv) >= 6 and argv[1] == "bunnies":
         bunnies(argv[2], argv[3], argv[4], argv[5])
     else:

@@ -2,10 +2,14 @@
 # Regenerates everything docs/results.md shows: the CSVs under docs/data/ and the figures under
 # docs/img/, from `cullide bench`, `cullide sweep`, peers_bench and scripts/plots.py.
 #
-# usage: scripts/results.sh [--quick | --full] [--build-dir DIR] [--threads T] [--skip-build]
+# usage: scripts/results.sh [--quick | --full | --goals] [--build-dir DIR] [--threads T] [--skip-build]
 #   --quick   (default) small scales and few frames: a few minutes on 2 quiet cores
 #   --full    the papers' scene sizes where the methods can afford it, more frames and resolutions
 #             (hours while the visibility methods cost seconds per frame at scale 1)
+#   --goals   only the speed issues' goal commands (#16: peers_bench at the papers' sizes, 1 -> 2
+#             threads, self-collision; #17: pipeline_bench, raster_bench), each run once, into
+#             docs/data/goals/ with the load before each, and their goal tables (goals.md; about
+#             15 minutes; --threads does not apply: the goals fix their thread counts)
 #   --build-dir DIR   where to build (default build-results); --skip-build uses it as it is
 #   --threads T       worker threads of every method and peer (default 0 = all cores)
 # Needs: cmake, ninja, g++; for the peers libfcl-dev, libbullet-dev, libembree-dev, libcgal-dev; for
@@ -23,10 +27,11 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --quick) mode=quick ;;
     --full) mode=full ;;
+    --goals) mode=goals ;;
     --build-dir) build="$2"; shift ;;
     --threads) threads="$2"; shift ;;
     --skip-build) skip_build=1 ;;
-    -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
     *) echo "results.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
   shift
@@ -36,6 +41,8 @@ data=docs/data
 img=docs/img
 mkdir -p "$data" "$img"
 log="$data/results.log"
+# --goals keeps its own log beside its data (the quick / full run's log stays as it is).
+if [ "$mode" = goals ]; then mkdir -p "$data/goals"; log="$data/goals/results.log"; fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 failures=0
@@ -75,8 +82,11 @@ if [ $skip_build -eq 0 ]; then
   if grep -q "peers_bench" "$build/build.ninja" 2>/dev/null; then
     step build-peers cmake --build "$build" --target peers_bench -j"$(nproc)"
   fi
-  if [ "$mode" = full ] && grep -q "pipeline_bench" "$build/build.ninja" 2>/dev/null; then
+  if [ "$mode" != quick ] && grep -q "pipeline_bench" "$build/build.ninja" 2>/dev/null; then
     step build-pipeline cmake --build "$build" --target pipeline_bench -j"$(nproc)"
+  fi
+  if [ "$mode" = goals ] && grep -q "raster_bench" "$build/build.ninja" 2>/dev/null; then
+    step build-raster cmake --build "$build" --target raster_bench -j"$(nproc)"
   fi
 fi
 cli=$(find "$build" -name cullide -type f -perm -u+x | head -n1)
@@ -87,6 +97,51 @@ py=python3
 for cand in /usr/bin/python3 python3; do
   if command -v "$cand" >/dev/null && "$cand" -c 'import matplotlib' 2>/dev/null; then py=$cand; break; fi
 done
+
+if [ "$mode" = goals ]; then
+  # The goal commands of issues #16 and #17, verbatim but for the output files; each is one run,
+  # and the load average before it is written beside its data (load.txt).
+  goals="$data/goals"
+  mkdir -p "$goals"
+  : >"$goals/load.txt"
+  at() { echo "$1: $(date -u '+%Y-%m-%d %H:%M UTC') $(uptime | sed 's/.*load/load/')" >>"$goals/load.txt"; }
+  echo "commit $(git rev-parse --short HEAD 2>/dev/null || echo '?')$(git diff --quiet 2>/dev/null || echo ' + local changes'), $(nproc) cores, $(uname -m)" >>"$goals/load.txt"
+  if [ -n "$peers" ]; then
+    at peers
+    step goal-peers "$peers" --scenes cylinders,tori,bunny-dragon,breaking,leaves,cloth --first-frame 30 \
+      --frame-step 5 --frames 2 --reps 3 --threads 2 --peers fcl-aabb,bullet-gimpact-exact,embree-collide \
+      --methods exact,rcullide,auto,qcullide --mesh-dir "$mesh_dir" --csv "$goals/peers.csv"
+  else
+    note "results.sh: peers_bench not built: no #16 peers goal"
+  fi
+  at threads
+  step goal-threads "$cli" bench --scenes cylinders,tori,bunny-dragon,breaking,leaves,cloth --methods exact,auto,rcullide,qcullide --first-frame 30 \
+    --frame-step 5 --frames 2 --threads 1,2 --reps 3 --mesh-dir "$mesh_dir" --no-progress --csv "$goals/threads.csv"
+  at self
+  step goal-self "$cli" bench --scenes cloth --methods exact,qcullide --self --first-frame 55 --frames 2 \
+    --threads 1,2 --reps 9 --no-progress --csv "$goals/self.csv"
+  pipeline=$(find "$build" -name pipeline_bench -type f -perm -u+x | head -n1)
+  if [ -n "$pipeline" ]; then
+    at pipeline
+    step goal-pipeline "$pipeline" --scale=0.1,cylinders=1,leaves=1,cloth=1 --frames=2 --reps=2 \
+      --benchmark_out="$goals/pipeline_bench.json" --benchmark_out_format=json
+  else
+    note "results.sh: pipeline_bench not built (OSMesa or Google Benchmark missing): no #17 pipeline goal"
+  fi
+  raster=$(find "$build" -name raster_bench -type f -perm -u+x | head -n1)
+  if [ -n "$raster" ]; then
+    at raster
+    step goal-raster "$raster" --benchmark_filter='^run/' --benchmark_min_time=0.2 \
+      --benchmark_out="$goals/raster_bench.json" --benchmark_out_format=json
+  else
+    note "results.sh: raster_bench not built: no #17 fill-rate goal"
+  fi
+  at end
+  "$py" scripts/plots.py goals "$goals" >"$goals/goals.md" 2>>"$log" || { failures=$((failures + 1)); note "  [goals] FAILED"; }
+  note "load at end: $(uptime | sed 's/.*load/load/')"
+  note "results.sh: done, $failures failed step(s); log in $log; tables in $goals/goals.md"
+  exit "$failures"
+fi
 
 common=(--threads "$threads" --mesh-dir "$mesh_dir" --no-progress)
 vis=exact,cullide,rcullide,rcullide-offset
