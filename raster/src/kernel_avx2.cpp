@@ -11,7 +11,9 @@
 // Either way the covered set is the scalar path's. The vector part is depth; per 8 pixels:
 //   z = fma(dzdy, y, fma(dzdx, x, z0))   (_mm256_fmadd_ps: one correctly rounded fma, as std::fma)
 //   clamp: max(z, 0) then min(z, 1)      (maxps returns its second operand when z is NaN: NaN -> 0,
-//                                         -0 -> +0, exactly `z > 0 ? z : 0`; minps likewise)
+//                                         -0 -> +0, exactly `z > 0 ? z : 0`; minps likewise;
+//                                         left out on wide D16 / D24 rectangles where it changes no
+//                                         encoded value: clamp_free)
 //   D24: cvtps2dq(z * 16777215)          (MXCSR round-to-nearest-even, as lrint)
 //   D16: bits(z * (65535/65536) + 128) & 0xffff
 //   D32F: compare as floats with the ordered/unordered predicate equal to C++'s operator
@@ -26,6 +28,9 @@
 // all four rejects the whole rectangle; an edge > 0 at all four is dropped from the span work
 // (wide rectangles; narrow ones go straight to the 8-lane coverage test, which rejects as cheaply).
 // stop_at_first (any-samples queries, mask off): return after the first row with a passing sample.
+// Wide rectangles count passing samples per lane and sum the lanes once (wide_rows); narrow ones
+// count each chunk's bits (a per-rectangle sum and clamp test cost more than they save there:
+// callgrind, raster_bench SmallTris). The AVX-512 kernel (kernel_avx512.cpp) has neither yet.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -113,28 +118,46 @@ inline __m256 plane_x8(const Plane8& p, __m256 fx) { return _mm256_fmadd_ps(p.dz
 // true when full), so a plain load and a blended store serve a partial chunk too. Returns the
 // passing-lane bits.
 // zx: plane_x8 of the 8 pixels, computed once per column of chunks by callers that visit it in many rows.
-template <DepthFormat Fmt, DepthFunc F, bool Write>
-inline unsigned chunk8(const Plane8& plane, std::uint32_t* row, int px, __m256 fy, __m256i cover, bool whole,
-                       __m256 zx) {
+// Clamp false: the caller knows that the clamp changes no encoded value in the lanes that `cover`
+// marks (clamp_free below). Returns the passing lanes (all ones), within `cover`.
+template <DepthFormat Fmt, DepthFunc F, bool Write, bool Clamp = true>
+inline __m256i pass_chunk8(const Plane8& plane, std::uint32_t* row, int px, __m256 fy, __m256i cover,
+                           bool whole, __m256 zx) {
     __m256 z = _mm256_fmadd_ps(plane.dzdy, fy, zx);
-    z = _mm256_max_ps(z, _mm256_setzero_ps());
-    z = _mm256_min_ps(z, _mm256_set1_ps(1.0f));
+    if constexpr (Clamp) {
+        z = _mm256_max_ps(z, _mm256_setzero_ps());
+        z = _mm256_min_ps(z, _mm256_set1_ps(1.0f));
+    }
     const __m256i incoming = encode8<Fmt>(z);
     std::uint32_t* p = row + px;
     const __m256i stored = whole ? _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p))
                                  : _mm256_maskload_epi32(reinterpret_cast<const int*>(p), cover);
     const __m256i pass = _mm256_and_si256(pass8<Fmt, F>(incoming, stored), cover);
-    const unsigned bits = lanes(pass);
     if constexpr (Write) {
         // A whole chunk is stored whether or not a lane passed (unchanged pixels rewritten with
         // their own value): the pass/fail pattern of writing draws is data, and a branch on it
         // mispredicted (perf, cylinders frame).
         if (whole)
             _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), _mm256_blendv_epi8(stored, incoming, pass));
-        else if (bits != 0)
+        else if (!_mm256_testz_si256(pass, pass))
             _mm256_maskstore_epi32(reinterpret_cast<int*>(p), pass, incoming);
     }
-    return bits;
+    return pass;
+}
+
+// pass_chunk8 as the passing-lane bits.
+template <DepthFormat Fmt, DepthFunc F, bool Write>
+inline unsigned chunk8(const Plane8& plane, std::uint32_t* row, int px, __m256 fy, __m256i cover, bool whole,
+                       __m256 zx) {
+    return lanes(pass_chunk8<Fmt, F, Write>(plane, row, px, fy, cover, whole, zx));
+}
+
+// The sum of the 8 unsigned lanes.
+inline std::uint64_t sum8(__m256i v) {
+    __m128i s = _mm_add_epi32(_mm256_castsi256_si128(v), _mm256_extracti128_si256(v, 1));
+    s = _mm_add_epi32(s, _mm_shuffle_epi32(s, 0x4e));
+    s = _mm_add_epi32(s, _mm_shuffle_epi32(s, 0xb1));
+    return static_cast<std::uint32_t>(_mm_cvtsi128_si32(s));
 }
 
 // Whether the chunk px..px+7 of a row of `stride` pixels lies in one column group of kHizTile and
@@ -198,23 +221,46 @@ std::uint64_t narrow_rows(const SetupTri& t, DepthRows depth, PixelRect rect, co
     return passed;
 }
 
-template <DepthFormat Fmt, DepthFunc F, bool Write>
-std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, bool stop_at_first) {
+// Whether the depth clamp (max with 0, min with 1) changes no encoded value on any pixel centre of
+// `rect`, so that the kernel may skip it there: D16 / D24 only, finite plane coefficients, and the
+// unclamped value in [0, 1] at the two corners that bound it. The bound is the one of pipeline.h
+// (raster_rect_hiz): each correctly rounded fma is monotone in its addend and in x or y, so over
+// the rectangle the value lies between its values at the corner against the signs of dzdx, dzdy
+// and the corner with them; then it is finite and in [0, 1] everywhere, where the clamp is the
+// identity except that it turns -0 into +0, which both encodings map to the same value
+// (cvtps2dq(-0 * 16777215) = 0; -0 * (65535 / 65536) + 128 = 128). D32F stores the float's bits,
+// so there -0 would differ: it always clamps. Lanes outside the rectangle are computed but never
+// stored or counted (the cover mask), whatever they hold.
+template <DepthFormat Fmt>
+inline bool clamp_free(const SetupTri& t, PixelRect r) {
+    if constexpr (Fmt == DepthFormat::D32F) {
+        return false;
+    } else {
+        if (!(std::isfinite(t.z0) && std::isfinite(t.dzdx) && std::isfinite(t.dzdy))) return false;
+        const bool x_up = !(t.dzdx < 0.0f), y_up = !(t.dzdy < 0.0f);
+        const auto z = [&t](int x, int y) {
+            return std::fma(t.dzdy, static_cast<float>(y), std::fma(t.dzdx, static_cast<float>(x), t.z0));
+        };
+        const float lo = z(x_up ? r.x0 : r.x1, y_up ? r.y0 : r.y1);
+        const float hi = z(x_up ? r.x1 : r.x0, y_up ? r.y1 : r.y0);
+        return lo >= 0.0f && hi <= 1.0f;
+    }
+}
+
+// The wide path of raster_rect8: each row's covered span (RowSpans) in chunks of 8 from its first
+// pixel. Clamp false when clamp_free holds for the rectangle. The passing lanes are counted per
+// lane (subtracting the all-ones pass mask, one instruction per chunk instead of a movemask, a
+// popcount and an add) and summed once at the end; a lane's count is at most the rectangle's rows
+// times its chunks per row, far below 2^31.
+template <DepthFormat Fmt, DepthFunc F, bool Write, bool Clamp>
+std::uint64_t wide_rows(const SetupTri& t, DepthRows depth, PixelRect rect, avx2::RowSpans& spans,
+                        bool stop_at_first) {
     const int rx0 = rect.x0, rx1 = rect.x1;
     const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-    std::uint64_t passed = 0;
-    if (rx1 - rx0 < kNarrow) {
-        std::int64_t e_row[3], sx[3], sy[3];
-        if (avx2::narrow_lanes_fit(t, rect, e_row, sx, sy)) {
-            return rx1 - rx0 < 8 ? narrow_rows<1, Fmt, F, Write>(t, depth, rect, e_row, sx, sy, stop_at_first)
-                                 : narrow_rows<2, Fmt, F, Write>(t, depth, rect, e_row, sx, sy, stop_at_first);
-        }
-    }
-    avx2::RowSpans spans;
-    if (!spans.init(t, rect)) return 0;
     const __m256i all = _mm256_set1_epi32(-1);
     const __m256 eight = _mm256_set1_ps(8.0f);
     const Plane8 plane(t);
+    __m256i count = _mm256_setzero_si256();
     for (int py = static_cast<int>(spans.y0); py <= spans.y1; ++py) {
         std::int64_t lo, hi;
         spans.next(rx0, rx1, lo, hi);
@@ -225,15 +271,34 @@ std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, b
         int px = static_cast<int>(lo);
         __m256 fx = lane_x8(px);  // stepped by 8 per chunk: exact, |px| < 2^24
         for (; px + 7 <= ihi; px += 8, fx = _mm256_add_ps(fx, eight))
-            passed += static_cast<unsigned>(std::popcount(chunk8<Fmt, F, Write>(plane, row, px, fy, all, true, plane_x8(plane, fx))));
+            count = _mm256_sub_epi32(
+                count, pass_chunk8<Fmt, F, Write, Clamp>(plane, row, px, fy, all, true, plane_x8(plane, fx)));
         if (px <= ihi) {
             const __m256i cover = _mm256_cmpgt_epi32(_mm256_set1_epi32(ihi - px + 1), iota);
-            passed += static_cast<unsigned>(std::popcount(
-                chunk8<Fmt, F, Write>(plane, row, px, fy, cover, own_chunk(px, depth.stride), plane_x8(plane, fx))));
+            count = _mm256_sub_epi32(
+                count, pass_chunk8<Fmt, F, Write, Clamp>(plane, row, px, fy, cover,
+                                                         own_chunk(px, depth.stride), plane_x8(plane, fx)));
         }
-        if (stop_at_first && passed != 0) return passed;
+        if (stop_at_first && !_mm256_testz_si256(count, count)) break;
     }
-    return passed;
+    return sum8(count);
+}
+
+template <DepthFormat Fmt, DepthFunc F, bool Write>
+std::uint64_t raster_rect8(const SetupTri& t, DepthRows depth, PixelRect rect, bool stop_at_first) {
+    const int rx0 = rect.x0, rx1 = rect.x1;
+    if (rx1 - rx0 < kNarrow) {
+        std::int64_t e_row[3], sx[3], sy[3];
+        if (avx2::narrow_lanes_fit(t, rect, e_row, sx, sy)) {
+            return rx1 - rx0 < 8
+                       ? narrow_rows<1, Fmt, F, Write>(t, depth, rect, e_row, sx, sy, stop_at_first)
+                       : narrow_rows<2, Fmt, F, Write>(t, depth, rect, e_row, sx, sy, stop_at_first);
+        }
+    }
+    avx2::RowSpans spans;
+    if (!spans.init(t, rect)) return 0;
+    return clamp_free<Fmt>(t, rect) ? wide_rows<Fmt, F, Write, false>(t, depth, rect, spans, stop_at_first)
+                                    : wide_rows<Fmt, F, Write, true>(t, depth, rect, spans, stop_at_first);
 }
 
 }  // namespace

@@ -10,10 +10,12 @@
 
 #include <algorithm>
 #include <bit>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -560,6 +562,108 @@ TEST_CASE("kernels and shrink_rect on made-up edge functions that are -1, 0, 1 o
     CHECK(covered_total > 100000);
     CHECK(partial_rows > 10000);
     CHECK(emptied > 100);
+}
+
+TEST_CASE(
+    "kernels on depth planes that meet 0 and 1 inside wide rectangles: the skipped clamp changes no bit") {
+    // The AVX2 kernel's wide path leaves out the clamp to [0, 1] on a D16 / D24 rectangle whose
+    // unclamped depths are all in [0, 1] by its two bounding corners (kernel_avx2.cpp, clamp_free).
+    // Planes here put a corner's depth exactly at 0, -0, the smallest floats either side of 0, 1 and
+    // the floats either side of 1, or a little beyond, with slopes of either sign, zero, -0, tiny and
+    // non-finite, so that the rule's edge cases decide; the result must be the portable kernel's
+    // (which always clamps), count and every stored bit, for every format, function and mask.
+    raster_test::SplitMix64 rng(0xc1a3bu);
+    constexpr int W = 160, H = 48;
+    const float kEdges[] = {0.0f,
+                            -0.0f,
+                            std::nextafter(0.0f, 1.0f),
+                            std::nextafter(0.0f, -1.0f),
+                            1.0f,
+                            std::nextafter(1.0f, 2.0f),
+                            std::nextafter(1.0f, 0.0f),
+                            -1e-7f,
+                            1e-7f,
+                            1.0f - 1e-7f,
+                            1.0f + 1e-7f};
+    const float kInf = std::numeric_limits<float>::infinity();
+    const auto slope = [&]() -> float {
+        switch (rng.below(8)) {
+            case 0:
+                return 0.0f;
+            case 1:
+                return -0.0f;
+            case 2:
+                return rng.uniform(-1e-6f, 1e-6f);
+            case 3:
+                return rng.chance(50) ? kInf : std::numeric_limits<float>::quiet_NaN();
+            default:
+                return rng.uniform(-0.02f, 0.02f);
+        }
+    };
+    std::uint64_t below_zero = 0, above_one = 0, inside = 0, checked = 0;
+    for (int n = 0; n < 4000; ++n) {
+        detail::PixelRect r;
+        r.x0 = static_cast<int>(rng.below(W - 24));
+        r.x1 = r.x0 + 16 +
+               static_cast<int>(rng.below(static_cast<std::uint32_t>(W - r.x0 - 16)));  // the wide path
+        r.y0 = static_cast<int>(rng.below(H));
+        r.y1 = r.y0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(H - r.y0)));
+        detail::SetupTri t{};
+        // Two edges cover everything; the third is everything or a random line through the rectangle.
+        for (int i = 0; i < 3; ++i) t.c[i] = 1;
+        if (rng.chance(50)) {
+            t.dcdx[2] = static_cast<std::int64_t>(rng.below(201)) - 100;
+            t.dcdy[2] = static_cast<std::int64_t>(rng.below(201)) - 100;
+            const int px = r.x0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(r.x1 - r.x0 + 1)));
+            const int py = r.y0 + static_cast<int>(rng.below(static_cast<std::uint32_t>(r.y1 - r.y0 + 1)));
+            t.c[2] = t.dcdx[2] * 256 * px - t.dcdy[2] * 256 * py;
+        }
+        t.x0 = r.x0;
+        t.y0 = r.y0;
+        t.x1 = r.x1;
+        t.y1 = r.y1;
+        t.dzdx = slope();
+        t.dzdy = slope();
+        // z0 so that a random corner's depth is (about) a value at the clamp's edges.
+        const int cx = rng.chance(50) ? r.x0 : r.x1, cy = rng.chance(50) ? r.y0 : r.y1;
+        const float target = kEdges[rng.below(static_cast<std::uint32_t>(std::size(kEdges)))];
+        t.z0 = std::isfinite(t.dzdx) && std::isfinite(t.dzdy)
+                   ? target - (t.dzdx * static_cast<float>(cx) + t.dzdy * static_cast<float>(cy))
+                   : target;
+        if (rng.chance(20)) t.z0 = target;  // exact at the origin-side corner when the slopes are 0
+        for (int py = r.y0; py <= r.y1; ++py) {
+            for (int px = r.x0; px <= r.x1; ++px) {
+                const float z =
+                    std::fma(t.dzdy, static_cast<float>(py), std::fma(t.dzdx, static_cast<float>(px), t.z0));
+                below_zero += z < 0.0f || std::signbit(z) ? 1u : 0u;
+                above_one += z > 1.0f ? 1u : 0u;
+                inside += z >= 0.0f && z <= 1.0f ? 1u : 0u;
+            }
+        }
+        const DepthFormat f = kFormats[rng.below(3)];
+        const DepthFunc func = kFuncs[rng.below(8)];
+        const bool write = rng.chance(50);
+        std::vector<std::uint32_t> c(W * H), d, e;
+        const float near_z = rng.chance(50) ? 0.0f : 1.0f;
+        for (auto& x : c)
+            x = rng.chance(30) ? (near_z == 0.0f ? 0u : 0xffffffu) : random_stored(rng, f, near_z);
+        d = c;
+        e = c;
+        CAPTURE(n);
+        const std::uint64_t nc =
+            detail::raster_rect_portable(t, f, func, write, c.data(), W, r.x0, r.y0, r.x1, r.y1, false);
+        CHECK(nc == rect_avx2(t, f, func, write, d.data(), W, r.x0, r.y0, r.x1, r.y1, false));
+        CHECK(nc == rect_avx512(t, f, func, write, e.data(), W, r.x0, r.y0, r.x1, r.y1, false));
+        CHECK(c == d);
+        CHECK(c == e);
+        ++checked;
+    }
+    MESSAGE("pixels with unclamped depth < 0 or -0: " << below_zero << ", > 1: " << above_one
+                                                      << ", in [0, 1]: " << inside);
+    CHECK(checked == 4000);
+    CHECK(below_zero > 10000);
+    CHECK(above_one > 10000);
+    CHECK(inside > 100000);
 }
 
 // SetupTri::fits32 lets the AVX2 narrow path skip its per-rectangle 32-bit bound: when setup sets
