@@ -580,8 +580,11 @@ def goals(goals_dir):
             parts = b["name"].split("/")  # run/<workload>/<size>/<threads>/<simd>/real_time
             if parts[0] != "run" or len(parts) < 5 or b.get("run_type") != "iteration":
                 continue
-            t[(parts[1], int(parts[2]), int(parts[3]), int(parts[4]))] = b["real_time"]
-        out.append("### Issue #17: raster throughput against OSMesa llvmpipe (`raster_bench`, ms per batch)\n")
+            t.setdefault((parts[1], int(parts[2]), int(parts[3]), int(parts[4])), []).append(b["real_time"])
+        reps = max((len(v) for v in t.values()), default=0)
+        t = {k: sorted(v)[len(v) // 2] for k, v in t.items()}  # the median of the repetitions
+        out.append("### Issue #17: raster throughput against OSMesa llvmpipe (`raster_bench`, ms per batch, "
+                   f"median of {reps} repetitions)\n")
         out.append(f"Load average in the benchmark's context: {doc.get('context', {}).get('load_avg', '?')}. "
                    "Goals: LargeTris >= 2x, SmallTris >= 4x llvmpipe at 2 threads.\n")
         out.append("| workload | size | OSMesa | ours 1 thread (portable) | ours 2 threads | OSMesa / ours at 1 / 2 threads | 2 / 1 | goal |")

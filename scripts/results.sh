@@ -131,7 +131,7 @@ if [ "$mode" = goals ]; then
   raster=$(find "$build" -name raster_bench -type f -perm -u+x | head -n1)
   if [ -n "$raster" ]; then
     at raster
-    step goal-raster "$raster" --benchmark_filter='^run/' --benchmark_min_time=0.2 \
+    step goal-raster "$raster" --benchmark_filter='^run/' --benchmark_min_time=0.2 --benchmark_repetitions=3 \
       --benchmark_out="$goals/raster_bench.json" --benchmark_out_format=json
   else
     note "results.sh: raster_bench not built: no #17 fill-rate goal"
