@@ -116,10 +116,10 @@ inline __m256 plane_x8(const Plane8& p, __m256 fx) { return _mm256_fmadd_ps(p.dz
 // Depth test (and write) of the 8 pixels px..px+7 of `row` at row centre fy; `cover` marks the
 // pixels to process (full: all 8). `whole`: the 8 pixels may be read and rewritten (own_chunk;
 // true when full), so a plain load and a blended store serve a partial chunk too. Returns the
-// passing-lane bits.
+// passing lanes (all ones), within `cover`.
 // zx: plane_x8 of the 8 pixels, computed once per column of chunks by callers that visit it in many rows.
 // Clamp false: the caller knows that the clamp changes no encoded value in the lanes that `cover`
-// marks (clamp_free below). Returns the passing lanes (all ones), within `cover`.
+// marks (clamp_free below).
 template <DepthFormat Fmt, DepthFunc F, bool Write, bool Clamp = true>
 inline __m256i pass_chunk8(const Plane8& plane, std::uint32_t* row, int px, __m256 fy, __m256i cover,
                            bool whole, __m256 zx) {
