@@ -610,8 +610,8 @@ def goals(goals_dir):
                 out.append(f"| {w} | {size}^2 | {fmt_ms(om) if om else '-'} | {fmt_ms(one)}" +
                            (f" ({fmt_ms(port)})" if port else "") + f" | {fmt_ms(two)} | {ratio} | {one / two:.2f}x | {reached} |")
         out.append("")
-        out.append("OSMesa runs once per workload and size (llvmpipe's own threads); the Restore and FullClear "
-                   "rows are compared with the OSMesa time of their workload.\n")
+        out.append("OSMesa is llvmpipe with its own threads (the row's thread count does not apply to it); the "
+                   "Restore and FullClear rows are compared with the OSMesa time of their workload.\n")
     print("\n".join(out))
 
 
