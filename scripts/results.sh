@@ -9,7 +9,7 @@
 #   --goals   only the speed issues' goal commands (#16: peers_bench at the papers' sizes, 1 -> 2
 #             threads, self-collision; #17: pipeline_bench, raster_bench), each run once, into
 #             docs/data/goals/ with the load before each, and their goal tables (goals.md; about
-#             15 minutes; --threads does not apply: the goals fix their thread counts)
+#             5 minutes on 2 cores; --threads does not apply: the goals fix their thread counts)
 #   --build-dir DIR   where to build (default build-results); --skip-build uses it as it is
 #   --threads T       worker threads of every method and peer (default 0 = all cores)
 # Needs: cmake, ninja, g++; for the peers libfcl-dev, libbullet-dev, libembree-dev, libcgal-dev; for
