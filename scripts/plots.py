@@ -598,12 +598,11 @@ def goals(goals_dir):
                 one, two = t.get((w, size, 1, 1)), t.get((w, size, 2, 1))
                 if one is None or two is None:
                     continue
-                om = t.get((w, size, 0, 1))
                 port = t.get((w, size, 1, 0))
-                base = w if w not in ("SmallTrisRestore", "SmallTrisFullClear") else "SmallTris"
-                if w == "LargeTrisRestore":
-                    base = "LargeTris"
-                om = om if om is not None else t.get((base, size, 0, 1))
+                # OSMesa runs the plain workloads only; the clear variants compare with theirs.
+                base = {"SmallTrisRestore": "SmallTris", "SmallTrisFullClear": "SmallTris",
+                        "LargeTrisRestore": "LargeTris"}.get(w, w)
+                om = t.get((base, size, 0, 1))
                 goal = {"LargeTris": 2.0, "SmallTris": 4.0}.get(w)
                 ratio = f"{om / one:.1f}x / {om / two:.1f}x" if om else "-"
                 reached = (f">= {goal:g}x: {yes(om / two >= goal)}" if goal and om else "-")
